@@ -1,0 +1,99 @@
+#pragma once
+// What every subcommand shares: the global options, turning --config/--set/flags into a typed
+// options struct, and the run directory with config.yaml, log.txt and results.json.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/run_dir.h"
+
+namespace cgsr::cli {
+
+struct GlobalOptions {
+  std::string config_file;         // --config FILE
+  std::vector<std::string> sets;   // --set key.path=value, repeatable
+  std::string out;                 // --out DIR
+  std::string log_level = "info";  // --log-level
+  std::optional<int> threads;      // --threads N (0 = all hardware threads)
+  std::optional<int64_t> seed;     // --seed N
+  bool print_config = false;       // --print-config
+};
+
+GlobalOptions& globals();
+void add_global_options(CLI::App& app);
+
+// Fields every command's options carry, so config.yaml alone reproduces a run.
+struct RunSettings {
+  int64_t seed = 0;
+  int threads = 0;
+};
+
+template <class T>
+void add_run_settings(config::Schema<T>& schema) {
+  schema.field("seed", static_cast<int64_t T::*>(&RunSettings::seed), "seed for every random number generator")
+      .at_least(0);
+  schema.field("threads", static_cast<int T::*>(&RunSettings::threads), "LibTorch and TBB threads (0 = all)")
+      .range(0, 1024);
+}
+
+// A command flag recorded as a config assignment, e.g. {"model=pan", "--model pan"}.
+struct FlagAssignment {
+  std::string assignment;
+  std::string origin;
+};
+
+// The document a command parses: --config, then --set, then the command's own flags, then
+// --seed/--threads.
+config::Document build_document(const std::vector<FlagAssignment>& flags);
+
+// Applies logging, threads and seed for a command about to run.
+void begin_command(const RunSettings& run);
+
+// Registers `name` as a subcommand that parses its options with `schema` and runs `body`.
+// `flags` registers the command's own CLI flags; each flag appends assignments to the vector.
+// The run directory exists when --out is given, or always when `always_run_dir` is true
+// (default runs/<name>-<time>). `body` returns the results written to results.json.
+template <class T>
+CLI::App* add_command(CLI::App& app, const std::string& name, const std::string& description,
+                      std::function<config::Schema<T>()> schema,
+                      std::function<void(CLI::App&, std::vector<FlagAssignment>&)> flags,
+                      std::function<nlohmann::ordered_json(const T&, RunDir*)> body, bool always_run_dir) {
+  CLI::App* sub = app.add_subcommand(name, description);
+  auto assignments = std::make_shared<std::vector<FlagAssignment>>();
+  if (flags) flags(*sub, *assignments);
+  sub->callback([=]() {
+    const auto the_schema = schema();
+    const config::Document doc = build_document(*assignments);
+    const T options = config::parse_document(doc, the_schema);
+    const YAML::Node resolved = the_schema.emit(options);
+    if (globals().print_config) {
+      std::fputs(config::to_yaml(resolved).c_str(), stdout);
+      return;
+    }
+    begin_command(options);
+    std::unique_ptr<RunDir> run_dir;
+    if (!globals().out.empty() || always_run_dir)
+      run_dir = std::make_unique<RunDir>(globals().out.empty() ? default_run_dir(name)
+                                                                  : std::filesystem::path(globals().out));
+    if (run_dir) run_dir->write_config(resolved);
+    const nlohmann::ordered_json results = body(options, run_dir.get());
+    if (run_dir) run_dir->write_results(results);
+  });
+  return sub;
+}
+
+// Adds `--name VALUE` to `sub`, recorded as the assignment "key=VALUE".
+void flag_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
+                 const std::string& key, const std::string& description);
+// Adds a boolean `--name` flag to `sub`, recorded as "key=true".
+void switch_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
+                   const std::string& key, const std::string& description);
+
+}  // namespace cgsr::cli

@@ -1,0 +1,41 @@
+// cgsr: lightweight super-resolution for real-time graphics. main() only wires subcommands
+// and turns errors into messages and exit codes (2 for user errors, 1 for internal ones).
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "cli/command.h"
+#include "cli/commands/info.h"
+#include "core/error.h"
+#include "core/logging.h"
+
+int main(int argc, char** argv) {
+  using namespace cgsr::cli;
+  CLI::App app{"cgsr: rendering-information guided super-resolution for real-time graphics"};
+  app.set_version_flag("--version", std::string("cgsr ") + CGSR_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();  // global options may also follow the subcommand
+  add_global_options(app);
+
+  setup_info(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const cgsr::Error& e) {
+    spdlog::debug("{}", e.what());
+    std::fprintf(stderr, "error: %s\n", e.what());
+    cgsr::finish_log_file();
+    return e.kind() == cgsr::ErrorKind::User ? 2 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: internal: %s\n", e.what());
+    cgsr::finish_log_file();
+    return 1;
+  }
+  cgsr::finish_log_file();
+  return 0;
+}

@@ -1,0 +1,29 @@
+# Helpers shared by every module: warnings, sanitizers and the precompiled torch header.
+
+function(cgsr_target_defaults target)
+  target_include_directories(${target} PUBLIC ${CGSR_SOURCE_ROOT})
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(CGSR_SANITIZE)
+    target_compile_options(${target} PUBLIC -fsanitize=address,undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# Compiling <torch/torch.h> costs ~20 s per translation unit on this machine. The header is
+# precompiled once, in cgsr_core, and every other target reuses that PCH (same flags).
+function(cgsr_use_torch_pch target)
+  if(TARGET cgsr_core AND NOT target STREQUAL "cgsr_core")
+    target_precompile_headers(${target} REUSE_FROM cgsr_core)
+  else()
+    target_precompile_headers(${target} PRIVATE ${CGSR_SOURCE_ROOT}/core/torch_pch.h)
+  endif()
+endfunction()
+
+# cgsr_add_module(NAME SOURCES ... DEPENDS ...): one library per module folder.
+function(cgsr_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS" ${ARGN})
+  add_library(cgsr_${name} STATIC ${ARG_SOURCES})
+  cgsr_target_defaults(cgsr_${name})
+  target_link_libraries(cgsr_${name} PUBLIC ${ARG_DEPENDS})
+  cgsr_use_torch_pch(cgsr_${name})
+endfunction()

@@ -1,0 +1,120 @@
+#include "core/config.h"
+
+#include <fstream>
+#include <sstream>
+
+namespace cgsr::config {
+
+struct Document::Data {
+  std::string origin = "<defaults>";
+  YAML::Node root = YAML::Node(YAML::NodeType::Map);
+  // Nodes written by --set, with the assignment that wrote them.
+  std::vector<std::pair<YAML::Node, std::string>> overrides;
+};
+
+Document::Document() : data_(std::make_shared<Data>()) {}
+
+Document Document::load_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw Error(path.string(), std::filesystem::exists(path) ? "cannot read the file" : "no such config file");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse(text.str(), path.string());
+}
+
+Document Document::parse(const std::string& text, const std::string& origin) {
+  Document doc;
+  doc.data_->origin = origin;
+  try {
+    YAML::Node root = YAML::Load(text);
+    if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+    doc.data_->root = root;
+  } catch (const YAML::Exception& e) {
+    throw Error(origin + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1),
+                "invalid YAML: " + e.msg);
+  }
+  if (!doc.data_->root.IsMap()) throw Error(origin, "the top level must be a map of keys");
+  return doc;
+}
+
+void Document::apply_override(const std::string& assignment, const std::string& origin) {
+  const size_t eq = assignment.find('=');
+  const std::string where = origin.empty() ? "--set " + assignment : origin;
+  if (eq == std::string::npos || eq == 0) throw Error(where, "expected key.path=value");
+  const auto keys = split(assignment.substr(0, eq), '.');
+  for (const auto& k : keys)
+    if (k.empty()) throw Error(where, "empty key in the key path");
+
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw Error(where, "the value is not valid YAML: " + e.msg);
+  }
+
+  // Walk down, creating maps as needed. yaml-cpp's operator[] on a Node returns a view that
+  // must be reassigned, so keep the chain explicit.
+  std::vector<YAML::Node> chain{data_->root};
+  for (size_t i = 0; i + 1 < keys.size(); ++i) {
+    YAML::Node next = chain.back()[keys[i]];
+    if (!next || next.IsNull()) {
+      chain.back()[keys[i]] = YAML::Node(YAML::NodeType::Map);
+      next = chain.back()[keys[i]];
+    } else if (!next.IsMap()) {
+      throw Error(where, "'" + keys[i] + "' is not a map, so it has no key '" + keys[i + 1] + "'");
+    }
+    chain.push_back(next);
+  }
+  chain.back()[keys.back()] = value;
+  data_->overrides.emplace_back(chain.back()[keys.back()], where);
+}
+
+const YAML::Node& Document::root() const { return data_->root; }
+const std::string& Document::origin() const { return data_->origin; }
+
+std::string Document::locate(const YAML::Node& node) const {
+  for (const auto& [written, where] : data_->overrides)
+    if (written.is(node)) return where;
+  if (!node.IsDefined()) return data_->origin;
+  const YAML::Mark mark = node.Mark();
+  if (mark.is_null()) return data_->origin;
+  return data_->origin + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+bool Document::is_override(const YAML::Node& node) const {
+  for (const auto& entry : data_->overrides)
+    if (entry.first.is(node)) return true;
+  return false;
+}
+
+void Cursor::fail(const YAML::Node& node, const std::string& what) const {
+  const std::string where = doc ? doc->locate(node) : std::string();
+  throw Error(where, path.empty() ? what : path + ": " + what);
+}
+
+namespace detail {
+std::string describe(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing (null)";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a map";
+  return "'" + node.Scalar() + "'";
+}
+}  // namespace detail
+
+std::string block_type(const Block& block) {
+  const Cursor at = block.cursor();
+  if (!block.node.IsMap()) at.fail(block.node, "expected a block {type: Name, ...}, got " + detail::describe(block.node));
+  const YAML::Node type = block.node["type"];
+  if (!type) at.fail(block.node, "missing required key 'type'");
+  return Codec<std::string>::decode(type, at.child("type"));
+}
+
+std::string to_yaml(const YAML::Node& node) {
+  YAML::Emitter out;
+  out << node;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace cgsr::config

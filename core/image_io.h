@@ -1,0 +1,33 @@
+#pragma once
+// Image files <-> CPU float32 CHW tensors.
+//   read:  8-bit and 16-bit PNG/PPM/PGM/BMP/TIFF scaled to [0,1]; 32-bit float TIFF and EXR as stored.
+//   write: the encoding follows the extension and `bits` (8 or 16 for PNG/PPM/TIFF, 32 for float
+//          TIFF and EXR); integer encodings clamp to [0,1] and round.
+// Colour channels are RGB in memory (OpenCV's BGR order is undone here, once).
+
+#include <torch/types.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cgsr {
+
+struct ImageReadOptions {
+  int channels = 0;  // expected channel count (1, 3 or 4); 0 accepts any
+};
+
+struct ImageWriteOptions {
+  int bits = 8;  // 8, 16 or 32 (float)
+};
+
+torch::Tensor read_image(const std::filesystem::path& path, const ImageReadOptions& options = {});
+
+// `image` is CHW (C = 1, 3 or 4) or HW. Written atomically. Non-finite values are an error.
+void write_image(const std::filesystem::path& path, const torch::Tensor& image, const ImageWriteOptions& options = {});
+
+// Encodes to memory with the format of `extension` (".png", ...): for size reports and tests.
+std::vector<unsigned char> encode_image(const std::string& extension, const torch::Tensor& image,
+                                        const ImageWriteOptions& options = {});
+
+}  // namespace cgsr

@@ -1,0 +1,63 @@
+#include "core/logging.h"
+
+#include <spdlog/sinks/basic_file_sink.h>
+#include <spdlog/sinks/dist_sink.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <unistd.h>
+
+#include "core/error.h"
+
+namespace cgsr {
+namespace {
+struct LogState {
+  std::shared_ptr<spdlog::sinks::dist_sink_mt> sinks;
+  std::shared_ptr<spdlog::sinks::basic_file_sink_mt> file;
+  std::filesystem::path file_path;
+};
+LogState& state() {
+  static LogState s;
+  return s;
+}
+}  // namespace
+
+void init_logging(const std::string& level) {
+  auto& s = state();
+  if (!s.sinks) {
+    s.sinks = std::make_shared<spdlog::sinks::dist_sink_mt>();
+    auto console = std::make_shared<spdlog::sinks::stderr_color_sink_mt>(
+        ::isatty(STDERR_FILENO) ? spdlog::color_mode::automatic : spdlog::color_mode::never);
+    console->set_pattern("[%H:%M:%S] %^%l%$ %v");
+    s.sinks->add_sink(console);
+    auto logger = std::make_shared<spdlog::logger>("cgsr", s.sinks);
+    spdlog::set_default_logger(logger);
+  }
+  const auto parsed = spdlog::level::from_str(level);
+  if (parsed == spdlog::level::off && level != "off")
+    throw Error("--log-level", "unknown level '" + level + "'; valid: trace, debug, info, warn, error, off");
+  spdlog::set_level(parsed);
+}
+
+void attach_log_file(const std::filesystem::path& path) {
+  auto& s = state();
+  if (!s.sinks) init_logging("info");
+  finish_log_file();
+  std::filesystem::create_directories(path.parent_path());
+  s.file_path = path;
+  s.file = std::make_shared<spdlog::sinks::basic_file_sink_mt>(path.string() + ".partial", /*truncate=*/true);
+  s.file->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %v");
+  s.sinks->add_sink(s.file);
+}
+
+void finish_log_file() {
+  auto& s = state();
+  if (!s.file) return;
+  s.file->flush();
+  s.sinks->remove_sink(s.file);
+  s.file.reset();
+  std::error_code ec;
+  std::filesystem::rename(s.file_path.string() + ".partial", s.file_path, ec);
+}
+
+}  // namespace cgsr

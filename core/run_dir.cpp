@@ -1,0 +1,36 @@
+#include "core/run_dir.h"
+
+#include <ctime>
+
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/logging.h"
+
+namespace cgsr {
+
+RunDir::RunDir(std::filesystem::path dir) : dir_(std::move(dir)) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw Error(dir_.string(), "cannot create the run directory: " + ec.message());
+  attach_log_file(dir_ / "log.txt");
+}
+
+RunDir::~RunDir() { finish_log_file(); }
+
+void RunDir::write_config(const YAML::Node& resolved) const {
+  write_file_atomic(file("config.yaml"), config::to_yaml(resolved));
+}
+
+void RunDir::write_results(const nlohmann::ordered_json& results) const {
+  write_file_atomic(file("results.json"), results.dump(2) + "\n");
+}
+
+std::filesystem::path default_run_dir(const std::string& command) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return std::filesystem::path("runs") / (command + "-" + stamp);
+}
+
+}  // namespace cgsr

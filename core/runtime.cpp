@@ -1,0 +1,55 @@
+#include "core/runtime.h"
+
+#include <oneapi/tbb/global_control.h>
+
+#include <memory>
+#include <thread>
+
+namespace cgsr {
+namespace {
+std::unique_ptr<tbb::global_control>& tbb_limit() {
+  static std::unique_ptr<tbb::global_control> limit;
+  return limit;
+}
+uint64_t& seed_storage() {
+  static uint64_t seed = 0;
+  return seed;
+}
+int& threads_storage() {
+  static int threads = 0;
+  return threads;
+}
+// SplitMix64: decorrelates seeds derived from nearby integers.
+uint64_t mix(uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+}  // namespace
+
+int set_threads(int threads) {
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  torch::set_num_threads(threads);
+  tbb_limit() = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      static_cast<size_t>(threads));
+  threads_storage() = threads;
+  return threads;
+}
+
+int thread_count() { return threads_storage() > 0 ? threads_storage() : torch::get_num_threads(); }
+
+void seed_everything(uint64_t seed) {
+  seed_storage() = seed;
+  torch::manual_seed(seed);
+}
+
+uint64_t global_seed() { return seed_storage(); }
+
+std::mt19937_64 make_rng(const char* purpose, uint64_t extra) {
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a over the purpose string
+  for (const char* p = purpose; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
+  return std::mt19937_64(mix(seed_storage() ^ mix(h) ^ mix(extra + 1)));
+}
+
+}  // namespace cgsr

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian packages cgsr builds and runs with. Does nothing when all are present.
+# Usage: scripts/install-deps.sh [--with-optional]
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libtorch-dev          # LibTorch 1.13 (CPU)
+  libopencv-dev         # image I/O, OpenCV DNN for export verification
+  libyaml-cpp-dev libtbb-dev libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libonnx-dev libprotobuf-dev protobuf-compiler   # ONNX export
+  libzip-dev libstb-dev                           # pk3 archives, TGA textures
+)
+# ONNX Runtime verification runs through the npm package onnxruntime-node; a machine
+# whose Node.js does not come from Debian already has npm.
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: run as root (or install the packages above with sudo apt-get install)" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"
