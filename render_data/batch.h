@@ -1,0 +1,24 @@
+#pragma once
+// What training and evaluation consume: aligned LR/HR colour and rendering information.
+// Rendering information is stacked in the order of render_channels.h, restricted to the
+// channels requested by the consumer (a model's channel list).
+
+#include <torch/types.h>
+
+#include <vector>
+
+#include "render_data/render_channels.h"
+
+namespace cgsr {
+
+struct Batch {
+  torch::Tensor lr_color;  // [N, 3, h, w] float32 in [0,1]
+  torch::Tensor lr_info;   // [N, C, h, w]; C = total_width(channels); may be empty when C = 0
+  torch::Tensor hr_color;  // [N, 3, s*h, s*w]
+  torch::Tensor hr_info;   // [N, C, s*h, s*w]
+  std::vector<RenderChannel> channels;
+  std::vector<int> frames;  // frame index of each item in the sequence
+  int scale = 2;
+};
+
+}  // namespace cgsr

@@ -1,0 +1,88 @@
+#include "render_data/render_channels.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/text.h"
+
+namespace cgsr {
+namespace {
+struct ChannelInfo {
+  RenderChannel channel;
+  std::string name;
+  int width;
+};
+const std::vector<ChannelInfo>& table() {
+  static const std::vector<ChannelInfo> t = {
+      {RenderChannel::Depth, "depth", 1},   {RenderChannel::Normal, "normal", 3},
+      {RenderChannel::NormalAngle, "normal_angle", 1}, {RenderChannel::Edge, "edge", 1},
+      {RenderChannel::Motion, "motion", 2},
+  };
+  return t;
+}
+const ChannelInfo& info(RenderChannel c) { return table()[static_cast<size_t>(c)]; }
+}  // namespace
+
+const std::vector<RenderChannel>& all_render_channels() {
+  static const std::vector<RenderChannel> all = [] {
+    std::vector<RenderChannel> v;
+    for (const auto& i : table()) v.push_back(i.channel);
+    return v;
+  }();
+  return all;
+}
+
+const std::string& channel_name(RenderChannel channel) { return info(channel).name; }
+int channel_width(RenderChannel channel) { return info(channel).width; }
+
+RenderChannel channel_from_name(const std::string& name) {
+  std::vector<std::string> names;
+  for (const auto& i : table()) {
+    if (i.name == name) return i.channel;
+    names.push_back(i.name);
+  }
+  throw Error("render channels", "unknown channel '" + name + "'" + did_you_mean(name, names) + "; valid: " + join(names));
+}
+
+int total_width(const std::vector<RenderChannel>& channels) {
+  int w = 0;
+  for (auto c : channels) w += channel_width(c);
+  return w;
+}
+
+std::vector<RenderChannel> parse_channels(const std::vector<std::string>& names) {
+  std::vector<RenderChannel> out;
+  for (const auto& n : names) {
+    const RenderChannel c = channel_from_name(n);
+    if (std::find(out.begin(), out.end(), c) != out.end())
+      throw Error("render channels", "channel '" + n + "' is listed twice");
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::string> channel_names(const std::vector<RenderChannel>& channels) {
+  std::vector<std::string> out;
+  for (auto c : channels) out.push_back(channel_name(c));
+  return out;
+}
+
+torch::Tensor normalize_depth(const torch::Tensor& linear_depth, double near, double far) {
+  if (!(near > 0) || !(far > near)) throw Error("depth", "need 0 < near < far, got near " + std::to_string(near) +
+                                                            ", far " + std::to_string(far));
+  const double inv_near = 1.0 / near, inv_far = std::isinf(far) ? 0.0 : 1.0 / far;
+  // 1/z of +inf is 0, so sky lands at (or beyond) the far plane without special cases.
+  const auto inv_z = torch::reciprocal(linear_depth.clamp_min(near));
+  return ((inv_near - inv_z) / (inv_near - inv_far)).clamp(0.0, 1.0);
+}
+
+torch::Tensor linearize_depth(const torch::Tensor& normalized_depth, double near, double far) {
+  if (!(near > 0) || !(far > near)) throw Error("depth", "need 0 < near < far");
+  const double inv_near = 1.0 / near, inv_far = std::isinf(far) ? 0.0 : 1.0 / far;
+  const auto inv_z = inv_near - normalized_depth.clamp(0.0, 1.0) * (inv_near - inv_far);
+  return torch::reciprocal(inv_z.clamp_min(1e-30));
+}
+
+}  // namespace cgsr

@@ -1,0 +1,43 @@
+#pragma once
+// The rendering information a network can use, as named channels in one fixed order.
+// This file is the contract between the data side (renderers, loaders) and the models: a model
+// records the channel names it uses, and every tensor of rendering information is stacked in
+// this order, each channel with the width given here.
+//
+//   name          width  range     meaning
+//   depth           1    [0,1]    normalized depth, z-buffer convention (see normalize_depth)
+//   normal          3    [-1,1]   view-space unit normal (x right, y up, z towards the camera);
+//                                 0 where there is no geometry (sky)
+//   normal_angle    1    [0,1]    angle between the normal and the direction to the camera,
+//                                 0 deg -> 0, 90 deg -> 1 (as in the CGSR data release); 0 for sky
+//   edge            1    {0,1}    object edges (depth discontinuities, id changes, normal creases)
+//   motion          2    pixels   screen-space motion to the previous frame, (dx, dy) in pixels of
+//                                 this resolution: a pixel at p was at p + motion in the previous frame
+
+#include <torch/types.h>
+
+#include <string>
+#include <vector>
+
+namespace cgsr {
+
+enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion };
+
+const std::vector<RenderChannel>& all_render_channels();  // in the fixed order above
+const std::string& channel_name(RenderChannel channel);
+RenderChannel channel_from_name(const std::string& name);  // cgsr::Error listing valid names
+int channel_width(RenderChannel channel);
+int total_width(const std::vector<RenderChannel>& channels);
+
+// Names <-> channels, sorted into the fixed order; duplicates are an error.
+std::vector<RenderChannel> parse_channels(const std::vector<std::string>& names);
+std::vector<std::string> channel_names(const std::vector<RenderChannel>& channels);
+
+// The one place where linear view-space depth becomes what a network sees: the z-buffer value
+// of a perspective projection, (1/near - 1/z) / (1/near - 1/far), clamped to [0,1]. 0 at the near
+// plane, 1 at the far plane and beyond (sky, z = inf). Finite for any near > 0, far <= inf.
+torch::Tensor normalize_depth(const torch::Tensor& linear_depth, double near, double far);
+// Inverse of normalize_depth for values in [0,1) (1 maps to far).
+torch::Tensor linearize_depth(const torch::Tensor& normalized_depth, double near, double far);
+
+}  // namespace cgsr
