@@ -1,0 +1,28 @@
+#include "render_data/scene_source.h"
+
+#include <mutex>
+
+namespace cgsr {
+
+Registry<SceneSourceFactory>& scene_sources() {
+  static Registry<SceneSourceFactory> registry("scene source");
+  return registry;
+}
+
+void register_builtin_scene_sources() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    auto& r = scene_sources();
+    (void)r;
+  });
+}
+
+SceneBundle make_scene(const config::Block& block, uint64_t seed) {
+  const std::string type = config::block_type(block);
+  SceneBundle bundle = scene_sources().get(type)(block, seed);
+  validate_scene(bundle.scene);
+  validate_camera_path(bundle.camera, "scene '" + bundle.scene.name + "'");
+  return bundle;
+}
+
+}  // namespace cgsr
