@@ -19,6 +19,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -277,7 +278,7 @@ class Schema {
     f.key = std::move(key);
     f.doc = std::move(doc);
     f.parse = [member](const YAML::Node& node, T& obj, const Cursor& at) {
-      obj.*member = Block{YAML::Clone(node), std::make_shared<Document>(*at.doc), at.path};
+      obj.*member = Block{node, std::make_shared<Document>(*at.doc), at.path};  // keeps source marks
     };
     f.emit = [member](const T& obj) { return YAML::Clone((obj.*member).node); };
     fields_.push_back(std::move(f));
@@ -289,12 +290,14 @@ class Schema {
   }
 
   // Parses `node` (a map, or null for "all defaults") into `out`, whose fields hold the defaults.
-  void parse(const YAML::Node& node, T& out, const Cursor& at) const {
+  // Keys in `reserved` belong to the caller (e.g. `type` of a typed block) and are skipped.
+  void parse(const YAML::Node& node, T& out, const Cursor& at, const std::vector<std::string>& reserved = {}) const {
     if (node && !node.IsNull() && !node.IsMap()) at.fail(node, "expected a map of keys, got " + detail::describe(node));
     std::set<std::string> seen;
     if (node && node.IsMap()) {
       for (const auto& kv : node) {
         const std::string key = kv.first.as<std::string>();
+        if (std::find(reserved.begin(), reserved.end(), key) != reserved.end()) continue;
         const Field* f = find(key);
         if (!f) {
           // A key written by --set has no file position; its value node knows the assignment.
@@ -361,12 +364,8 @@ T parse_document(const Document& doc, const Schema<T>& schema) {
 // Parses a {type: Name, ...} block's options (every key but `type`) with `schema`.
 template <class T>
 T parse_block_options(const Block& block, const Schema<T>& schema) {
-  YAML::Node rest(YAML::NodeType::Map);
-  if (block.node.IsMap())
-    for (const auto& kv : block.node)
-      if (kv.first.as<std::string>() != "type") rest[kv.first] = kv.second;
   T out{};
-  schema.parse(rest, out, block.cursor());
+  schema.parse(block.node, out, block.cursor(), {"type"});
   return out;
 }
 

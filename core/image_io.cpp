@@ -105,6 +105,8 @@ std::vector<unsigned char> encode_image(const std::string& extension, const torc
   std::vector<int> params;
   if (ext == ".png") params = {cv::IMWRITE_PNG_COMPRESSION, 6};
   if (ext == ".exr") params = {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT};
+  // OpenCV's default for float TIFF is SGILOG, which is lossy; LZW is lossless.
+  if (ext == ".tif" || ext == ".tiff") params = {cv::IMWRITE_TIFF_COMPRESSION, 5};
   std::vector<unsigned char> bytes;
   if (!cv::imencode(ext, mat, bytes, params)) throw Error("image" + ext, "OpenCV could not encode the image");
   return bytes;

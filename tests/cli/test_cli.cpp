@@ -1,0 +1,83 @@
+// The real cgsr executable: help, version, info, run directories and config errors.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "tests/support/cli_runner.h"
+
+using cgsr::test::run_cgsr;
+using cgsr::test::scratch_dir;
+namespace fs = std::filesystem;
+
+TEST(Cli, HelpListsSubcommands) {
+  const auto r = run_cgsr("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("info"), std::string::npos);
+  EXPECT_NE(r.out.find("--threads"), std::string::npos);
+}
+
+TEST(Cli, Version) {
+  const auto r = run_cgsr("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out.rfind("cgsr ", 0), 0u) << r.out;
+}
+
+TEST(Cli, NoSubcommandIsAUsageError) { EXPECT_EQ(run_cgsr("").exit_code, 2); }
+
+TEST(Cli, InfoPrintsVersionsAndThreads) {
+  const auto r = run_cgsr("info --json --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["system"]["libtorch"].get<std::string>().substr(0, 4), "1.13");
+  EXPECT_EQ(j["system"]["threads"].get<int>(), 1);
+  EXPECT_FALSE(j["system"]["opencv"].get<std::string>().empty());
+  EXPECT_FALSE(j["system"]["cpu_simd"].get<std::string>().empty());
+}
+
+TEST(Cli, RunDirectoryHoldsConfigLogAndResults) {
+  const auto dir = scratch_dir("cli-run");
+  const auto r = run_cgsr("info --seed 5 --out " + (dir / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto config = cgsr::read_file(dir / "run" / "config.yaml");
+  EXPECT_NE(config.find("seed: 5"), std::string::npos) << config;
+  EXPECT_NO_THROW(nlohmann::json::parse(cgsr::read_file(dir / "run" / "results.json")));
+  EXPECT_TRUE(fs::exists(dir / "run" / "log.txt"));
+  for (const auto& entry : fs::directory_iterator(dir / "run"))  // nothing half-written left
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+TEST(Cli, ConfigFileErrorsNameFileLineKeyAndSuggestion) {
+  const auto dir = scratch_dir("cli-config");
+  const auto file = dir / "info.yaml";
+  cgsr::write_file_atomic(file, "seed: 3\njsno: true\n");
+  const auto r = run_cgsr("info --config " + file.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("error: " + file.string() + ":2:1: jsno: unknown key 'jsno' (did you mean 'json'?)"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(Cli, WrongTypeAndOutOfRangeAreUserErrors) {
+  auto r = run_cgsr("info --set seed=abc");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--set seed=abc: seed: expected an integer, got 'abc'"), std::string::npos) << r.err;
+  r = run_cgsr("info --set threads=5000");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("threads: must be in [0, 1024]"), std::string::npos) << r.err;
+  r = run_cgsr("info --set threads=-1");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST(Cli, MissingConfigFileIsAUserError) {
+  const auto r = run_cgsr("info --config /nonexistent/cgsr.yaml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("/nonexistent/cgsr.yaml"), std::string::npos) << r.err;
+}
+
+TEST(Cli, PrintConfigShowsResolvedDefaults) {
+  const auto r = run_cgsr("info --print-config --set json=true");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("json: true"), std::string::npos);
+  EXPECT_NE(r.out.find("threads: 0"), std::string::npos);
+}

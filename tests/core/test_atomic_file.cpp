@@ -1,0 +1,51 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+using namespace cgsr;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("cgsr-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+size_t file_count(const fs::path& dir) {
+  return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+}  // namespace
+
+TEST(AtomicFile, WritesAndReplaces) {
+  const auto dir = fresh_dir("atomic");
+  write_file_atomic(dir / "a.txt", "first");
+  write_file_atomic(dir / "a.txt", "second");
+  EXPECT_EQ(read_file(dir / "a.txt"), "second");
+  EXPECT_EQ(file_count(dir), 1u);  // no temporary left behind
+}
+
+TEST(AtomicFile, AFailingWriterKeepsTheOldFile) {
+  const auto dir = fresh_dir("atomic-fail");
+  write_file_atomic(dir / "a.txt", "old");
+  EXPECT_THROW(write_atomic_with(dir / "a.txt",
+                                 [](const fs::path& tmp) {
+                                   write_file_atomic(tmp, "half");
+                                   throw Error("writer", "interrupted");
+                                 }),
+               Error);
+  EXPECT_EQ(read_file(dir / "a.txt"), "old");
+  EXPECT_EQ(file_count(dir), 1u);
+}
+
+TEST(AtomicFile, MissingFileNamesIt) {
+  try {
+    read_file("/nonexistent/cgsr/file.txt");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/cgsr/file.txt"), std::string::npos);
+  }
+}

@@ -1,0 +1,181 @@
+// Config schemas: defaults, overrides and every error a user can make, with its location.
+#include <gtest/gtest.h>
+
+#include "core/config.h"
+#include "core/error.h"
+
+using namespace cgsr;
+using namespace cgsr::config;
+
+namespace {
+struct Camera {
+  double fov = 60.0;
+  std::vector<double> position{0, 0, 0};
+};
+struct Light {
+  std::string kind = "point";
+  double intensity = 1.0;
+};
+struct SceneOptions {
+  std::string name;
+  int frames = 300;
+  bool shadows = false;
+  std::vector<std::string> channels{"depth"};
+  Camera camera;
+  std::vector<Light> lights;
+  Block source;
+};
+
+Schema<Camera> camera_schema() {
+  Schema<Camera> s;
+  s.field("fov", &Camera::fov, "vertical field of view in degrees").range(1, 179);
+  s.field("position", &Camera::position, "x, y, z").check([](const auto& v) { return v.size() == 3; },
+                                                           "expected 3 numbers");
+  return s;
+}
+Schema<Light> light_schema() {
+  Schema<Light> s;
+  s.field("kind", &Light::kind, "light type").one_of({"point", "directional"});
+  s.field("intensity", &Light::intensity, "intensity").at_least(0);
+  return s;
+}
+Schema<SceneOptions> scene_schema() {
+  Schema<SceneOptions> s;
+  s.field("name", &SceneOptions::name, "scene name").required();
+  s.field("frames", &SceneOptions::frames, "frames to render").range(1, 100000);
+  s.field("shadows", &SceneOptions::shadows, "shadow maps");
+  s.field("channels", &SceneOptions::channels, "rendering channels").one_of({"depth", "normal", "edge"});
+  s.section("camera", &SceneOptions::camera, camera_schema(), "camera");
+  s.list("lights", &SceneOptions::lights, light_schema(), "lights");
+  s.block("source", &SceneOptions::source, "scene source");
+  return s;
+}
+
+SceneOptions parse(const std::string& yaml, const std::vector<std::string>& sets = {}) {
+  Document doc = Document::parse(yaml, "scene.yaml");
+  for (const auto& s : sets) doc.apply_override(s);
+  return parse_document(doc, scene_schema());
+}
+
+std::string error_of(const std::string& yaml, const std::vector<std::string>& sets = {}) {
+  try {
+    parse(yaml, sets);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+}  // namespace
+
+TEST(Config, DefaultsComeFromCode) {
+  const auto s = parse("name: hall\n");
+  EXPECT_EQ(s.name, "hall");
+  EXPECT_EQ(s.frames, 300);
+  EXPECT_EQ(s.camera.fov, 60.0);
+  EXPECT_TRUE(s.lights.empty());
+}
+
+TEST(Config, ParsesNestedSectionsAndLists) {
+  const auto s = parse(
+      "name: hall\nframes: 12\nshadows: true\nchannels: [depth, edge]\n"
+      "camera: {fov: 75, position: [1, 2, 3]}\nlights:\n  - {kind: directional, intensity: 2}\n  - {}\n");
+  EXPECT_EQ(s.frames, 12);
+  EXPECT_TRUE(s.shadows);
+  EXPECT_EQ(s.channels, (std::vector<std::string>{"depth", "edge"}));
+  EXPECT_EQ(s.camera.position[2], 3.0);
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_EQ(s.lights[0].kind, "directional");
+  EXPECT_EQ(s.lights[1].kind, "point");
+}
+
+TEST(Config, UnknownKeySuggestsTheClosestAndGivesLineAndColumn) {
+  const auto e = error_of("name: hall\ncamera:\n  fvo: 70\n");
+  EXPECT_NE(e.find("scene.yaml:3:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("camera.fvo"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'fov'"), std::string::npos) << e;
+}
+
+TEST(Config, WrongTypeOutOfRangeAndMissingKeys) {
+  auto e = error_of("name: hall\nframes: many\n");
+  EXPECT_NE(e.find("scene.yaml:2:9: frames: expected an integer, got 'many'"), std::string::npos) << e;
+  e = error_of("name: hall\nframes: 0\n");
+  EXPECT_NE(e.find("frames: must be in [1, 100000]"), std::string::npos) << e;
+  e = error_of("name: hall\ncamera: {fov: 500}\n");
+  EXPECT_NE(e.find("camera.fov: must be in [1, 179]"), std::string::npos) << e;
+  e = error_of("frames: 3\n");
+  EXPECT_NE(e.find("missing required key 'name'"), std::string::npos) << e;
+  e = error_of("name: hall\nlights: [{kind: spot}]\n");
+  EXPECT_NE(e.find("lights[0].kind: 'spot' is not one of: point, directional"), std::string::npos) << e;
+  e = error_of("name: hall\ncamera: {position: [1, 2]}\n");
+  EXPECT_NE(e.find("expected 3 numbers"), std::string::npos) << e;
+  e = error_of("name: hall\nframes: .nan\n");
+  EXPECT_NE(e.find("frames: expected an integer"), std::string::npos) << e;
+}
+
+TEST(Config, NonFiniteNumbersAreRejected) {
+  const auto e = error_of("name: hall\ncamera: {fov: .inf}\n");
+  EXPECT_NE(e.find("expected a finite number"), std::string::npos) << e;
+}
+
+TEST(Config, InvalidYamlNamesTheLine) {
+  const auto e = error_of("name: hall\ncamera: {fov: 3\n");
+  EXPECT_NE(e.find("scene.yaml:"), std::string::npos) << e;
+  EXPECT_NE(e.find("invalid YAML"), std::string::npos) << e;
+}
+
+TEST(Config, OverridesParseAsYamlAndCreateNestedKeys) {
+  const auto s = parse("name: hall\n", {"frames=42", "camera.position=[4, 5, 6]", "shadows=true"});
+  EXPECT_EQ(s.frames, 42);
+  EXPECT_EQ(s.camera.position[0], 4.0);
+  EXPECT_TRUE(s.shadows);
+}
+
+TEST(Config, OverrideErrorsNameTheAssignment) {
+  auto e = error_of("name: hall\n", {"frames=lots"});
+  EXPECT_NE(e.find("--set frames=lots: frames: expected an integer"), std::string::npos) << e;
+  e = error_of("name: hall\n", {"framez=3"});
+  EXPECT_NE(e.find("--set framez=3"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'frames'"), std::string::npos) << e;
+  EXPECT_THROW(parse("name: hall\n", {"frames"}), Error);
+  EXPECT_THROW(parse("name: hall\n", {"name.inner=3"}), Error);  // name is a scalar
+}
+
+TEST(Config, TypedBlocksKeepTheirLocation) {
+  const auto s = parse("name: hall\nsource:\n  type: procedural\n  rooms: 3\n");
+  EXPECT_EQ(block_type(s.source), "procedural");
+  struct Procedural {
+    int rooms = 1;
+  };
+  Schema<Procedural> schema;
+  schema.field("rooms", &Procedural::rooms, "rooms").range(1, 10);
+  EXPECT_EQ(parse_block_options(s.source, schema).rooms, 3);
+
+  const auto bad = parse("name: hall\nsource:\n  type: procedural\n  romos: 3\n");
+  try {
+    parse_block_options(bad.source, schema);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.yaml:4:3: source.romos"), std::string::npos) << e.what();
+  }
+  const auto untyped = parse("name: hall\nsource: {rooms: 3}\n");
+  EXPECT_THROW(block_type(untyped.source), Error);
+}
+
+TEST(Config, EmitRoundTrips) {
+  const auto s = parse("name: hall\nframes: 7\nlights: [{kind: directional}]\ncamera: {fov: 33}\n");
+  const std::string text = to_yaml(scene_schema().emit(s));
+  const auto again = parse_document(Document::parse(text, "emitted"), scene_schema());
+  EXPECT_EQ(again.frames, 7);
+  EXPECT_EQ(again.camera.fov, 33.0);
+  ASSERT_EQ(again.lights.size(), 1u);
+  EXPECT_EQ(again.lights[0].kind, "directional");
+}
+
+TEST(Config, MissingFileIsAnError) {
+  try {
+    Document::load_file("/nonexistent/x.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/x.yaml: no such config file"), std::string::npos);
+  }
+}
