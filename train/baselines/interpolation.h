@@ -1,0 +1,19 @@
+#pragma once
+// Classic interpolating upscalers. All use the pixel-centre convention of DESIGN.md: output
+// pixel j samples the input at (j + 0.5) / scale - 0.5, with edge pixels replicated.
+
+#include <torch/types.h>
+
+namespace cgsr {
+
+torch::Tensor upscale_nearest(const torch::Tensor& lr, int scale);
+torch::Tensor upscale_bilinear(const torch::Tensor& lr, int scale);
+torch::Tensor upscale_bicubic(const torch::Tensor& lr, int scale);  // Keys cubic, a = -0.75
+torch::Tensor upscale_lanczos(const torch::Tensor& lr, int scale, int lobes = 3);
+
+// The resampling matrix [out, in] of a separable kernel along one axis, normalized per row.
+// `kernel(x)` gives the weight of a tap at distance x; taps beyond `support` are ignored.
+torch::Tensor resampling_matrix(int64_t in_size, int64_t out_size, double support,
+                                const std::function<double(double)>& kernel);
+
+}  // namespace cgsr
