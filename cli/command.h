@@ -59,12 +59,14 @@ void begin_command(const RunSettings& run);
 // Registers `name` as a subcommand that parses its options with `schema` and runs `body`.
 // `flags` registers the command's own CLI flags; each flag appends assignments to the vector.
 // The run directory exists when --out is given, or always when `always_run_dir` is true
-// (default runs/<name>-<time>). `body` returns the results written to results.json.
+// (default runs/<name>-<time>). `body` gets the options, the resolved config and the run
+// directory, and returns the results written to results.json.
 template <class T>
 CLI::App* add_command(CLI::App& app, const std::string& name, const std::string& description,
                       std::function<config::Schema<T>()> schema,
                       std::function<void(CLI::App&, std::vector<FlagAssignment>&)> flags,
-                      std::function<nlohmann::ordered_json(const T&, RunDir*)> body, bool always_run_dir) {
+                      std::function<nlohmann::ordered_json(const T&, const YAML::Node&, RunDir*)> body,
+                      bool always_run_dir) {
   CLI::App* sub = app.add_subcommand(name, description);
   auto assignments = std::make_shared<std::vector<FlagAssignment>>();
   if (flags) flags(*sub, *assignments);
@@ -83,7 +85,7 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
       run_dir = std::make_unique<RunDir>(globals().out.empty() ? default_run_dir(name)
                                                                   : std::filesystem::path(globals().out));
     if (run_dir) run_dir->write_config(resolved);
-    const nlohmann::ordered_json results = body(options, run_dir.get());
+    const nlohmann::ordered_json results = body(options, resolved, run_dir.get());
     if (run_dir) run_dir->write_results(results);
   });
   return sub;
