@@ -1,0 +1,93 @@
+#include "render_data/edges.h"
+
+#include <oneapi/tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace cgsr {
+namespace {
+
+struct EdgeInput {
+  int W = 0, H = 0;
+  const float* w = nullptr;       // 1/z, 0 where there is no geometry
+  const float* n = nullptr;       // 3 planes or null
+  const int32_t* id = nullptr;    // or null
+  float depth_threshold = 0, cos_crease = -2;
+};
+
+// Discontinuity between p = (y, x) and its neighbour q = p + (dy, dx) (dx, dy >= 0 pairs only,
+// the caller symmetrises).
+bool discontinuous(const EdgeInput& in, int y, int x, int dy, int dx) {
+  const size_t plane = static_cast<size_t>(in.W) * in.H;
+  const size_t p = static_cast<size_t>(y) * in.W + x, q = static_cast<size_t>(y + dy) * in.W + (x + dx);
+  const float wp = in.w[p], wq = in.w[q];
+  if ((wp > 0) != (wq > 0)) return true;
+  if (!(wp > 0)) return false;  // both empty
+  if (in.id && in.id[p] != in.id[q]) return true;
+  if (in.n) {
+    const float c = in.n[p] * in.n[q] + in.n[p + plane] * in.n[q + plane] + in.n[p + 2 * plane] * in.n[q + 2 * plane];
+    if (c < in.cos_crease) return true;
+  }
+  // Linear extrapolation of 1/z from each side (first order at borders and next to empty pixels).
+  const int by = y - dy, bx = x - dx, ay = y + 2 * dy, ax = x + 2 * dx;
+  float pred_q = wp, pred_p = wq;
+  if (by >= 0 && bx >= 0) {
+    const float wb = in.w[static_cast<size_t>(by) * in.W + bx];
+    if (wb > 0) pred_q = 2 * wp - wb;
+  }
+  if (ay < in.H && ax < in.W) {
+    const float wa = in.w[static_cast<size_t>(ay) * in.W + ax];
+    if (wa > 0) pred_p = 2 * wq - wa;
+  }
+  const float tolerance = in.depth_threshold * std::max(wp, wq);
+  return std::abs(wq - pred_q) > tolerance && std::abs(wp - pred_p) > tolerance;
+}
+
+}  // namespace
+
+torch::Tensor detect_edges(const torch::Tensor& depth, const torch::Tensor& normal, const torch::Tensor& ids,
+                           const EdgeSettings& settings) {
+  const auto d = depth.dim() == 3 ? depth.squeeze(0) : depth;
+  CGSR_CHECK(d.dim() == 2, "detect_edges needs an [H,W] depth map");
+  const int H = static_cast<int>(d.size(0)), W = static_cast<int>(d.size(1));
+  // 1/z: +inf and 0 (no geometry) both become 0.
+  const auto inv = torch::where(d.isfinite() & (d > 0), torch::reciprocal(d.to(torch::kFloat32)),
+                                torch::zeros({}, torch::kFloat32))
+                       .contiguous();
+  torch::Tensor n, id;
+  EdgeInput in;
+  in.W = W;
+  in.H = H;
+  in.w = inv.data_ptr<float>();
+  in.depth_threshold = settings.depth_threshold;
+  if (normal.defined()) {
+    n = normal.to(torch::kFloat32).reshape({3, H, W}).contiguous();
+    in.n = n.data_ptr<float>();
+    in.cos_crease = std::cos(settings.crease_angle * 3.14159265358979f / 180.0f);
+  }
+  if (ids.defined() && settings.id_changes) {
+    id = ids.to(torch::kInt32).reshape({H, W}).contiguous();
+    in.id = id.data_ptr<int32_t>();
+  }
+  auto out = torch::zeros({1, H, W}, torch::kFloat32);
+  float* e = out.data_ptr<float>();
+  tbb::parallel_for(0, H, [&](int y) {
+    for (int x = 0; x < W; ++x) {
+      const float wp = in.w[static_cast<size_t>(y) * W + x];
+      if (!(wp > 0)) continue;  // empty pixels are never edges
+      bool edge = false;
+      // Right and down neighbours: p is marked when it is nearer or tied (p is left/top).
+      if (x + 1 < W && discontinuous(in, y, x, 0, 1)) edge |= wp >= in.w[static_cast<size_t>(y) * W + x + 1];
+      if (!edge && y + 1 < H && discontinuous(in, y, x, 1, 0)) edge |= wp >= in.w[static_cast<size_t>(y + 1) * W + x];
+      // Left and up neighbours: p is marked when strictly nearer.
+      if (!edge && x > 0 && discontinuous(in, y, x - 1, 0, 1)) edge |= wp > in.w[static_cast<size_t>(y) * W + x - 1];
+      if (!edge && y > 0 && discontinuous(in, y - 1, x, 1, 0)) edge |= wp > in.w[static_cast<size_t>(y - 1) * W + x];
+      e[static_cast<size_t>(y) * W + x] = edge ? 1.0f : 0.0f;
+    }
+  });
+  return out;
+}
+
+}  // namespace cgsr

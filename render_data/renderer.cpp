@@ -1,0 +1,203 @@
+#include "render_data/renderer.h"
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/blocked_range2d.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+
+namespace cgsr {
+namespace {
+
+constexpr float kHalfPi = 1.57079632679f;
+
+float encode_srgb(float linear) {
+  const float l = std::clamp(linear, 0.0f, 1.0f);
+  return l <= 0.0031308f ? 12.92f * l : 1.055f * std::pow(l, 1.0f / 2.4f) - 0.055f;
+}
+
+// Everything one render() call owns: the cameras, the vertex stage output, the visibility
+// buffer and the target G-buffer.
+struct RenderContext {
+  FrameCamera camera, previous;
+  std::vector<Vec4> clip;    // per vertex, clip space of `camera`
+  std::vector<float> depth;  // per vertex, -z_view
+  std::vector<ScreenTriangle> triangles;
+  VisibilityBuffer visibility;
+  GBuffer target;
+};
+
+// Motion to the previous frame for a world point (w = 1) or a direction (w = 0, sky):
+// previous pixel position minus the current pixel centre; 0 when the point is behind the
+// previous camera.
+Vec2 motion_of(const FrameCamera& previous, Vec4 world, float cx, float cy) {
+  const Vec4 c = previous.view_projection * world;
+  if (!(c.w > 1e-6f)) return {0, 0};
+  const Vec2 p = clip_to_pixel(previous, c);
+  return {p.x - cx, p.y - cy};
+}
+
+}  // namespace
+
+Vec3 sky_color(const Sky& sky, Vec3 direction) {
+  const float up = std::clamp(normalize(direction).y, 0.0f, 1.0f);
+  return lerp(sky.horizon, sky.zenith, up);
+}
+
+SceneRenderer::SceneRenderer(const Scene& scene, const RenderSettings& settings)
+    : settings_(settings), geometry_(scene) {
+  CGSR_CHECK(settings.tile_size >= 4, "tile size must be at least 4");
+  if (settings.shadow.map_size < 16) throw Error("render settings", "shadow map size must be at least 16");
+  const Scene& s = geometry_.scene();
+  shadow_maps_.resize(s.lights.size());
+  if (settings.shadows)
+    for (size_t i = 0; i < s.lights.size(); ++i)
+      if (s.lights[i].shadows) shadow_maps_[i] = ShadowMap(geometry_, s.lights[i], settings.shadow);
+  shader_ = std::make_unique<BlinnPhongShader>(s, shadow_maps_);
+}
+
+GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous, int width, int height,
+                              float near_plane, float far_plane) const {
+  if (width <= 0 || height <= 0) throw Error("render", "image size must be positive");
+  RenderContext ctx;
+  ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane);
+  ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);
+  const SceneGeometry& g = geometry_;
+  const Scene& scene = g.scene();
+
+  // Vertex stage: world -> clip space of the current camera.
+  const size_t nv = g.vertex_count();
+  ctx.clip.resize(nv);
+  ctx.depth.resize(nv);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      const Vec3 p = g.positions[v];
+      ctx.clip[v] = ctx.camera.view_projection * Vec4{p.x, p.y, p.z, 1};
+      ctx.depth[v] = ctx.clip[v].w;
+    }
+  });
+
+  // Triangle setup and rasterization: pixel space, near plane at w = near.
+  RasterInput in;
+  in.clip = &ctx.clip;
+  in.depth = &ctx.depth;
+  in.indices = &g.indices;
+  in.cull_back = &g.cull_back;
+  in.alpha_tested = &g.alpha_tested;
+  in.w_min = near_plane;
+  in.width = width;
+  in.height = height;
+  in.tile_size = settings_.tile_size;
+  ctx.triangles = setup_triangles(in);
+  rasterize(in, ctx.triangles, ctx.visibility,
+            [&g](const ScreenTriangle& t, double x, double y) { return g.alpha_covers(t, x, y); });
+
+  GBuffer& out = ctx.target;
+  out.width = width;
+  out.height = height;
+  out.color = torch::empty({3, height, width}, torch::kFloat32);
+  out.depth = torch::empty({1, height, width}, torch::kFloat32);
+  out.normal = torch::empty({3, height, width}, torch::kFloat32);
+  out.normal_angle = torch::empty({1, height, width}, torch::kFloat32);
+  out.object_id = torch::empty({1, height, width}, torch::kInt32);
+  out.material_id = torch::empty({1, height, width}, torch::kInt32);
+  out.motion = torch::empty({2, height, width}, torch::kFloat32);
+  const size_t plane = static_cast<size_t>(width) * height;
+  float* color = out.color.data_ptr<float>();
+  float* depth = out.depth.data_ptr<float>();
+  float* normal = out.normal.data_ptr<float>();
+  float* angle = out.normal_angle.data_ptr<float>();
+  int32_t* object = out.object_id.data_ptr<int32_t>();
+  int32_t* material = out.material_id.data_ptr<int32_t>();
+  float* motion = out.motion.data_ptr<float>();
+  const FrameCamera& cam = ctx.camera;
+  const float inf = std::numeric_limits<float>::infinity();
+
+  // Resolve: one shading per visible pixel, tile by tile.
+  const int ts = settings_.tile_size;
+  tbb::parallel_for(tbb::blocked_range2d<int>(0, height, ts, 0, width, ts), [&](const tbb::blocked_range2d<int>& r) {
+    for (int i = r.rows().begin(); i < r.rows().end(); ++i)
+      for (int j = r.cols().begin(); j < r.cols().end(); ++j) {
+        const size_t p = static_cast<size_t>(i) * width + j;
+        const float cx = j + 0.5f, cy = i + 0.5f;
+        const int32_t si = ctx.visibility.screen_index[p];
+        const ScreenTriangle* tri = si >= 0 ? &ctx.triangles[si] : nullptr;
+        const Material* mat = tri ? &g.material_of(tri->triangle) : nullptr;
+        Vec3 linear;
+        if (!tri || mat->sky) {
+          // No geometry (or a sky surface): the sky at infinity, moving with camera rotation only.
+          const Vec3 ray = pixel_ray(cam, cx, cy);
+          linear = sky_color(scene.sky, ray);
+          depth[p] = inf;
+          for (int c = 0; c < 3; ++c) normal[c * plane + p] = 0;
+          angle[p] = 0;
+          object[p] = material[p] = -1;
+          const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx, cy);
+          motion[p] = m.x;
+          motion[plane + p] = m.y;
+        } else {
+          // World space: perspective-correct interpolation of the original triangle's vertices.
+          float b[3];
+          tri->original_barycentrics(cx, cy, b);
+          const uint32_t* idx = &g.indices[static_cast<size_t>(tri->triangle) * 3];
+          auto interp3 = [&](const std::vector<Vec3>& a) { return a[idx[0]] * b[0] + a[idx[1]] * b[1] + a[idx[2]] * b[2]; };
+          const Vec3 world = interp3(g.positions);
+          Vec3 n = normalize(interp3(g.normals));
+          if (!tri->front_facing) n = -n;  // two-sided surface seen from behind
+          const Vec3 to_eye = normalize(cam.pose.position - world);
+          if (length(n) == 0) n = to_eye;
+
+          SurfacePoint s;
+          s.position = world;
+          s.normal = n;
+          s.to_eye = to_eye;
+          s.material = mat;
+          s.albedo = mat->tint * interp3(g.colors);
+          if (mat->albedo_texture >= 0) {
+            const UvFootprint f = uv_footprint(g, *tri, cx, cy);
+            const LinearRgba t = g.textures[mat->albedo_texture].sample_trilinear(f.uv, f.duv_dx, f.duv_dy);
+            s.albedo = s.albedo * Vec3{t.r, t.g, t.b};
+          }
+          if (mat->lightmap_texture >= 0) {
+            const Vec2 lm = g.lightmap_uvs[idx[0]] * b[0] + g.lightmap_uvs[idx[1]] * b[1] + g.lightmap_uvs[idx[2]] * b[2];
+            const LinearRgba t = g.textures[mat->lightmap_texture].sample_bilinear_clamped(lm);
+            s.lightmap = {t.r, t.g, t.b};
+          }
+          linear = shader_->shade(s);
+          if (scene.fog.density > 0) {
+            const float dist = length(world - cam.pose.position);
+            const float f = 1.0f - std::exp(-scene.fog.density * std::max(0.0f, dist - scene.fog.start));
+            linear = lerp(linear, scene.fog.color, f);
+          }
+
+          // View space: depth, normal and its angle to the direction towards the camera.
+          depth[p] = ctx.visibility.depth[p];
+          const Vec3 nv = normalize(cam.view.transform_direction(n));
+          const Vec3 pv = cam.view.transform_point(world);
+          const float cos_a = std::clamp(dot(nv, normalize(-pv)), -1.0f, 1.0f);
+          normal[p] = nv.x;
+          normal[plane + p] = nv.y;
+          normal[2 * plane + p] = nv.z;
+          angle[p] = std::min(1.0f, std::acos(cos_a) / kHalfPi);
+          const Mesh& mesh = g.mesh_of(tri->triangle);
+          object[p] = mesh.object_id;
+          material[p] = mesh.material;
+          const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx, cy);
+          motion[p] = m.x;
+          motion[plane + p] = m.y;
+        }
+        color[p] = encode_srgb(linear.x);
+        color[plane + p] = encode_srgb(linear.y);
+        color[2 * plane + p] = encode_srgb(linear.z);
+      }
+  });
+
+  out.edge = detect_edges(out.depth, out.normal, out.object_id, settings_.edges);
+  return std::move(out);
+}
+
+}  // namespace cgsr

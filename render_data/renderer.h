@@ -1,0 +1,53 @@
+#pragma once
+// The software renderer: a scene prepared once (flattened geometry, mip chains, shadow maps),
+// then any number of frames rendered independently at any resolution. No global state: each
+// render() call builds its own RenderContext (camera, matrices, visibility buffer, target
+// G-buffer), so frames and resolutions may render concurrently.
+//
+// Per frame: vertex stage (world -> clip space), triangle setup and tile-parallel rasterization
+// (raster_core.h, pixel space), then a tile-parallel resolve that shades each visible pixel
+// once (shading.h, world space), applies fog, writes the G-buffer (view space) and motion
+// vectors (reprojection into the previous camera's pixel space), then edges (edges.h).
+
+#include <memory>
+#include <vector>
+
+#include "render_data/camera.h"
+#include "render_data/edges.h"
+#include "render_data/gbuffer.h"
+#include "render_data/scene_geometry.h"
+#include "render_data/shading.h"
+#include "render_data/shadow_maps.h"
+
+namespace cgsr {
+
+struct RenderSettings {
+  bool shadows = true;  // shadow maps for lights with Light::shadows
+  ShadowSettings shadow;
+  EdgeSettings edges;
+  int tile_size = 32;  // pixels per side of a raster tile
+};
+
+class SceneRenderer {
+ public:
+  SceneRenderer(const Scene& scene, const RenderSettings& settings);
+
+  // Renders the view from `pose` at width x height. `previous` is the camera of the previous
+  // frame (motion vectors reproject each pixel's world point into it; pass `pose` for none).
+  GBuffer render(const CameraPose& pose, const CameraPose& previous, int width, int height, float near_plane,
+                 float far_plane) const;
+
+  const SceneGeometry& geometry() const { return geometry_; }
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  RenderSettings settings_;
+  SceneGeometry geometry_;
+  std::vector<ShadowMap> shadow_maps_;  // one per scene light
+  std::unique_ptr<SurfaceShader> shader_;
+};
+
+// Sky colour seen along a world-space direction (scene.h Sky), linear RGB.
+Vec3 sky_color(const Sky& sky, Vec3 direction);
+
+}  // namespace cgsr

@@ -1,0 +1,59 @@
+#pragma once
+// Small hand-built scenes for the render_data tests.
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "render_data/scene.h"
+
+namespace cgsr::test {
+
+// One untextured material (white, matte) and a light so shading is non-trivial.
+inline Scene empty_scene(const std::string& name = "test") {
+  Scene s;
+  s.name = name;
+  Material m;
+  m.name = "white";
+  s.materials.push_back(m);
+  Light l;
+  l.type = LightType::Directional;
+  l.direction = {0.3f, -1.0f, -0.2f};
+  s.lights.push_back(l);
+  return s;
+}
+
+// A triangle with a constant normal (facing the camera when counter-clockwise seen from it).
+inline void add_triangle(Scene& s, Vec3 a, Vec3 b, Vec3 c, int object_id) {
+  Mesh m;
+  m.name = "triangle" + std::to_string(object_id);
+  m.positions = {a, b, c};
+  const Vec3 n = normalize(cross(b - a, c - a));
+  m.normals = {n, n, n};
+  m.uvs = {{0, 0}, {1, 0}, {0, 1}};
+  m.indices = {0, 1, 2};
+  m.object_id = object_id;
+  s.meshes.push_back(m);
+}
+
+// A quad centre + u + v (counter-clockwise seen from the side cross(u, v) points to).
+inline void add_quad(Scene& s, Vec3 centre, Vec3 u, Vec3 v, int object_id) {
+  Mesh m;
+  m.name = "quad" + std::to_string(object_id);
+  m.positions = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
+  const Vec3 n = normalize(cross(u, v));
+  m.normals = {n, n, n, n};
+  m.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.object_id = object_id;
+  s.meshes.push_back(m);
+}
+
+inline std::filesystem::path temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cgsr_test_render_data_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace cgsr::test
