@@ -1,0 +1,34 @@
+#pragma once
+// What a search strategy knows about a candidate: its spec in, scores out. The search command
+// implements this with the trainer (warm start, a few epochs, validation); the search itself
+// never sees training, so candidates could as well be evaluated on other machines.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "models/arch_spec.h"
+
+namespace cgsr {
+
+struct CandidateScore {
+  double val_psnr = 0, val_ssim = 0;
+  double image_loss = 0, geometry_loss = 0;  // validation loss terms (the joint objective)
+  int64_t params = 0, macs = 0;              // inference network, at the evaluation LR size
+  std::optional<double> latency_ms;          // measured when the fitness asks for it
+  double train_seconds = 0;
+};
+
+nlohmann::ordered_json to_json(const CandidateScore& score);
+CandidateScore candidate_score_from_json(const nlohmann::json& j);
+
+class Evaluator {
+ public:
+  virtual ~Evaluator() = default;
+  // Trains (warm start from the parent) and validates one candidate. Must be deterministic for
+  // a given spec, so that a resumed search reaches the same result.
+  virtual CandidateScore evaluate(const ArchSpec& spec) = 0;
+  // The parent itself, validated the same way (no training).
+  virtual CandidateScore evaluate_parent() = 0;
+};
+
+}  // namespace cgsr

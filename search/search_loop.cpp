@@ -1,0 +1,121 @@
+#include "search/search_loop.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "core/progress.h"
+#include "core/runtime.h"
+
+namespace cgsr {
+
+config::Schema<SearchOptions> search_schema() {
+  config::Schema<SearchOptions> s;
+  s.field("strategy", &SearchOptions::strategy, "search strategy").one_of(strategy_registry().names());
+  s.field("population", &SearchOptions::population, "P: new candidates per generation").range(1, 10000);
+  s.field("selection_ratio", &SearchOptions::selection_ratio, "H = ratio x P candidates survive").range(0.01, 1.0);
+  s.field("generations", &SearchOptions::generations, "generation limit").range(1, 10000);
+  s.field("min_candidates", &SearchOptions::min_candidates, "stop when fewer unseen candidates remain").at_least(1);
+  s.field("tolerance_db", &SearchOptions::tolerance_db, "pick: validation PSNR within this of the parent").at_least(0);
+  s.section("space", &SearchOptions::space, search_space_schema(), "what the search may change");
+  s.section("operators", &SearchOptions::operators, strategy_schema(), "mutation and crossover");
+  s.section("fitness", &SearchOptions::fitness, fitness_schema(), "how candidates are ranked");
+  return s;
+}
+
+Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& candidates,
+                         const SearchOptions& options, bool* is_parent) {
+  const Candidate* best = nullptr;
+  for (const auto& c : candidates) {
+    if (c.score.val_psnr < parent.score.val_psnr - options.tolerance_db) continue;
+    const double size = size_of(c.score, options.fitness.size_metric);
+    if (!best) {
+      best = &c;
+      continue;
+    }
+    const double best_size = size_of(best->score, options.fitness.size_metric);
+    if (size < best_size || (size == best_size && c.fitness < best->fitness)) best = &c;
+  }
+  if (is_parent) *is_parent = best == nullptr;
+  return best ? *best : parent;
+}
+
+SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
+                        const SearchOptions& options) {
+  const SearchSpace space(parent_spec, options.space);
+  auto strategy = strategy_registry().get(options.strategy)(space, options.operators);
+  SearchResult result;
+
+  // The parent, validated once: the reference for fitness and the pick rule.
+  const std::string parent_key = SearchSpace::key(space.parent());
+  result.parent.spec = space.parent();
+  result.parent.key = parent_key;
+  result.parent.generation = -1;
+  if (const auto* e = history.find(parent_key)) {
+    result.parent.score = e->score;
+  } else {
+    result.parent.score = evaluator.evaluate_parent();
+    history.append({-1, space.parent(), parent_key, result.parent.score});
+  }
+  result.parent.fitness = fitness(result.parent.score, result.parent.score, options.fitness);
+  spdlog::info("search: parent {} validates at {:.3f} dB with {} params", spec_summary(space.parent()),
+               result.parent.score.val_psnr, result.parent.score.params);
+
+  const int survivors_wanted = std::max(1, static_cast<int>(std::lround(options.selection_ratio * options.population)));
+  std::vector<Candidate> survivors;
+  std::set<std::string> evaluated_keys{parent_key};
+  auto seen = [&](const std::string& key) { return evaluated_keys.count(key) > 0; };
+
+  for (int generation = 0; generation < options.generations; ++generation) {
+    // Each generation draws from its own stream: a resumed search proposes the same specs.
+    auto rng = make_rng("search-generation", static_cast<uint64_t>(generation));
+    const auto proposals = strategy->propose(survivors, options.population, seen, rng);
+    if (static_cast<int>(proposals.size()) < options.min_candidates) {
+      result.stop_reason = "only " + std::to_string(proposals.size()) + " unseen candidate(s) left in generation " +
+                           std::to_string(generation);
+      break;
+    }
+    Progress progress("search generation " + std::to_string(generation), static_cast<int64_t>(proposals.size()));
+    std::vector<Candidate> generation_candidates;
+    for (const auto& spec : proposals) {
+      Candidate c;
+      c.spec = spec;
+      c.key = SearchSpace::key(spec);
+      c.generation = generation;
+      if (const auto* e = history.find(c.key)) {
+        c.score = e->score;  // evaluated before an interruption
+      } else {
+        c.score = evaluator.evaluate(spec);
+        history.append({generation, spec, c.key, c.score});
+      }
+      c.fitness = fitness(c.score, result.parent.score, options.fitness);
+      evaluated_keys.insert(c.key);
+      generation_candidates.push_back(c);
+      result.evaluated.push_back(c);
+      progress.set_status(spec_summary(spec) + " " + std::to_string(c.score.val_psnr).substr(0, 6) + " dB");
+      progress.advance();
+    }
+    progress.finish();
+
+    survivors.insert(survivors.end(), generation_candidates.begin(), generation_candidates.end());
+    std::stable_sort(survivors.begin(), survivors.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.fitness < b.fitness; });
+    if (static_cast<int>(survivors.size()) > survivors_wanted) survivors.resize(survivors_wanted);
+    result.generations_run = generation + 1;
+
+    bool none = false;
+    const Candidate best_so_far = pick_candidate(result.parent, result.evaluated, options, &none);
+    spdlog::info("generation {}: {} candidates, best fitness {:.4f} ({:.3f} dB, {} params); pick so far: {}", generation,
+                 generation_candidates.size(), survivors.front().fitness, survivors.front().score.val_psnr,
+                 survivors.front().score.params,
+                 none ? std::string("the parent (no candidate within tolerance)")
+                      : spec_summary(best_so_far.spec) + " with " + std::to_string(best_so_far.score.params) + " params");
+  }
+  if (result.stop_reason.empty()) result.stop_reason = "generation limit " + std::to_string(options.generations);
+  result.pick = pick_candidate(result.parent, result.evaluated, options, &result.pick_is_parent);
+  return result;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,43 @@
+#pragma once
+// The CGSR training objective (Eq. 1 of the paper, with the weights made explicit):
+//   L_t = ||HR - SR|| + lambda_g ||HR_r - SR_r|| + lambda_r sum_i ||R_i||_1 + lambda_s sum_k ||S_k||_1
+// image and geometry terms are mean squared (L2, default) or mean absolute (L1) errors; R_i are
+// the RIT gates; S_k the channels a search candidate is about to remove (their per-channel L1
+// importance), so they fade before they are cut. A zero weight disables its term.
+
+#include <torch/types.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "models/sr_network.h"
+#include "render_data/batch.h"
+
+namespace cgsr {
+
+struct LossOptions {
+  std::string image_norm = "l2";     // l2 | l1
+  std::string geometry_norm = "l2";  // l2 | l1
+  double lambda_geometry = 0.1;
+  double lambda_rit = 1e-4;
+  double lambda_shrink = 1e-4;
+};
+config::Schema<LossOptions> loss_schema();
+
+// Channels to fade, per layer group (indices into the group's channels).
+using ShrinkTargets = std::map<std::string, std::vector<int64_t>>;
+
+struct LossTerms {
+  torch::Tensor total;  // differentiable scalar
+  double image = 0, geometry = 0, rit = 0, shrink = 0;
+};
+
+LossTerms cgsr_loss(const SRNetworkImpl& net, const TrainOutput& output, const Batch& batch,
+                    const LossOptions& options, const ShrinkTargets& shrink = {});
+
+// Mean squared or mean absolute error, by name ("l2" | "l1").
+torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, const std::string& norm);
+
+}  // namespace cgsr
