@@ -2,6 +2,8 @@
 
 #include <mutex>
 
+#include "render_data/q3/q3_scene_source.h"
+
 namespace cgsr {
 
 Registry<SceneSourceFactory>& scene_sources() {
@@ -13,7 +15,7 @@ void register_builtin_scene_sources() {
   static std::once_flag once;
   std::call_once(once, [] {
     auto& r = scene_sources();
-    (void)r;
+    q3::register_q3_scene_source(r);
   });
 }
 
