@@ -11,10 +11,22 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libonnx-dev libprotobuf-dev protobuf-compiler   # ONNX export
   libzip-dev libstb-dev                           # pk3 archives, TGA textures
+  python3-torch                                   # torch.jit.load check of TorchScript exports
 )
 # ONNX Runtime verification runs through the npm package onnxruntime-node; a machine
 # whose Node.js does not come from Debian already has npm.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+
+# ONNX Runtime for export verification and `cgsr bench --onnx`: the CPU build ships inside the
+# npm package; --ignore-scripts skips its install script (which would only fetch GPU binaries).
+install_onnxruntime_node() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tools/onnxruntime"
+  if [ ! -f "$dir/node_modules/onnxruntime-node/package.json" ]; then
+    echo "install-deps: npm ci --ignore-scripts in $dir"
+    (cd "$dir" && npm ci --ignore-scripts --no-audit --no-fund)
+  fi
+}
 
 missing=()
 for p in "${packages[@]}"; do
@@ -24,6 +36,7 @@ for p in "${packages[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
+  install_onnxruntime_node
   exit 0
 fi
 
@@ -35,3 +48,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_onnxruntime_node

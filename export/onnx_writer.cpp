@@ -1,0 +1,399 @@
+#include "export/onnx_writer.h"
+
+#include <torch/torch.h>
+
+#include <onnx/checker.h>
+#include <onnx/defs/schema.h>
+#include <onnx/onnx_pb.h>
+#include <onnx/shape_inference/implementation.h>
+
+#include <cmath>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/text.h"
+#include "export/bicubic_kernel.h"
+#include "export/export_signature.h"
+
+namespace cgsr {
+
+const char* cubic_resize_name(CubicResize mode) { return mode == CubicResize::Conv ? "conv" : "native"; }
+
+CubicResize cubic_resize_from_name(const std::string& name) {
+  if (name == "conv") return CubicResize::Conv;
+  if (name == "native") return CubicResize::Native;
+  throw Error("cubic_resize", "unknown mode '" + name + "' (valid: conv, native)" + did_you_mean(name, {"conv", "native"}));
+}
+
+namespace {
+
+// Builds the GraphProto op by op. Tensor names: graph inputs/outputs by the export signature,
+// op outputs by op name, initializers by "<op name>.<role>".
+class Writer {
+ public:
+  Writer(const graph::Graph& graph, const OnnxOptions& options)
+      : graph_(graph), options_(options), signature_(export_signature(graph)) {
+    if (!options.dynamic_size && (options.width <= 0 || options.height <= 0))
+      throw Error("onnx export", "a fixed-size export needs a positive input size, got " +
+                                     std::to_string(options.width) + "x" + std::to_string(options.height));
+    model_.set_ir_version(onnx::IR_VERSION);
+    model_.set_producer_name("cgsr");
+    model_.set_producer_version(CGSR_VERSION);
+    model_.set_domain("cgsr");
+    auto* opset = model_.add_opset_import();
+    opset->set_domain("");
+    opset->set_version(kOnnxOpset);
+    for (const auto& [key, value] : options.metadata) {
+      auto* prop = model_.add_metadata_props();
+      prop->set_key(key);
+      prop->set_value(value);
+    }
+    g_ = model_.mutable_graph();
+    g_->set_name(options.model_name);
+    names_.resize(graph.values.size());
+  }
+
+  onnx::ModelProto build() {
+    for (const auto& port : signature_.inputs) {
+      names_[port.value] = claim(port.name);
+      declare(g_->add_input(), port);
+    }
+    const int output_value = signature_.output.value;
+    for (const auto& op : graph_.ops) {
+      // The op producing the graph output writes `sr` directly.
+      const std::string out = claim(op.output == output_value ? std::string(kExportOutput) : op.name);
+      names_[op.output] = out;
+      emit(op, out);
+    }
+    if (names_[output_value] != kExportOutput) {  // the output is a graph input: nothing computes it
+      node("Identity", op_context("output"), {names_[output_value]}, {claim(kExportOutput)});
+    }
+    declare(g_->add_output(), signature_.output);
+    return std::move(model_);
+  }
+
+ private:
+  static std::string op_context(const std::string& name) { return "onnx export: op '" + name + "'"; }
+
+  std::string claim(const std::string& name) {
+    CGSR_CHECK(used_.insert(name).second, "onnx export: tensor name '" + name + "' used twice");
+    return name;
+  }
+
+  // Spatial size of a value at the fixed export size.
+  int64_t height_of(int value) const { return options_.height * graph_.values.at(value).factor; }
+  int64_t width_of(int value) const { return options_.width * graph_.values.at(value).factor; }
+
+  void declare(onnx::ValueInfoProto* info, const ExportPort& port) {
+    info->set_name(port.name);
+    auto* type = info->mutable_type()->mutable_tensor_type();
+    type->set_elem_type(onnx::TensorProto::FLOAT);
+    auto* shape = type->mutable_shape();
+    const std::string suffix = port.factor == 1 ? "" : (port.name == kExportOutput ? "_sr" : "_info");
+    const auto dim = [&](int64_t fixed, const std::string& symbol) {
+      auto* d = shape->add_dim();
+      if (options_.dynamic_size && !symbol.empty())
+        d->set_dim_param(symbol);
+      else
+        d->set_dim_value(fixed);
+    };
+    dim(1, "batch");
+    dim(port.channels, "");
+    dim(options_.height * port.factor, "height" + suffix);
+    dim(options_.width * port.factor, "width" + suffix);
+    std::string doc = port.name == kExportOutput ? "super-resolved RGB, x" + std::to_string(port.factor)
+                      : port.name == kExportColorInput ? "low-resolution RGB in [0,1]"
+                                                       : "rendering information (" + join(port.channel_names) + ")" +
+                                                             (port.factor > 1 ? " at " + std::to_string(port.factor) +
+                                                                                    "x the colour size"
+                                                                              : " at the colour size");
+    info->set_doc_string(doc);
+  }
+
+  onnx::NodeProto* node(const std::string& type, const std::string& name, const std::vector<std::string>& inputs,
+                        const std::vector<std::string>& outputs) {
+    auto* n = g_->add_node();
+    n->set_op_type(type);
+    n->set_name(name);
+    for (const auto& i : inputs) n->add_input(i);
+    for (const auto& o : outputs) n->add_output(o);
+    return n;
+  }
+
+  static void attr(onnx::NodeProto* n, const std::string& name, int64_t v) {
+    auto* a = n->add_attribute();
+    a->set_name(name);
+    a->set_type(onnx::AttributeProto::INT);
+    a->set_i(v);
+  }
+  static void attr(onnx::NodeProto* n, const std::string& name, double v) {
+    auto* a = n->add_attribute();
+    a->set_name(name);
+    a->set_type(onnx::AttributeProto::FLOAT);
+    a->set_f(static_cast<float>(v));
+  }
+  static void attr(onnx::NodeProto* n, const std::string& name, const std::string& v) {
+    auto* a = n->add_attribute();
+    a->set_name(name);
+    a->set_type(onnx::AttributeProto::STRING);
+    a->set_s(v);
+  }
+  static void attr(onnx::NodeProto* n, const std::string& name, const std::vector<int64_t>& v) {
+    auto* a = n->add_attribute();
+    a->set_name(name);
+    a->set_type(onnx::AttributeProto::INTS);
+    for (auto x : v) a->add_ints(x);
+  }
+
+  std::string initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape) {
+    const auto t = value.detach().to(torch::kCPU, torch::kFloat).contiguous();
+    int64_t count = 1;
+    for (auto d : shape) count *= d;
+    CGSR_CHECK(t.numel() == count, "onnx export: initializer '" + name + "' has " + std::to_string(t.numel()) +
+                                       " values for shape of " + std::to_string(count));
+    if (!torch::isfinite(t).all().item<bool>())
+      throw Error("onnx export: tensor '" + name + "'", "contains NaN or infinite values");
+    auto* init = g_->add_initializer();
+    init->set_name(claim(name));
+    init->set_data_type(onnx::TensorProto::FLOAT);
+    for (auto d : shape) init->add_dims(d);
+    init->set_raw_data(t.data_ptr<float>(), static_cast<size_t>(t.numel()) * sizeof(float));
+    return name;
+  }
+
+  std::string int64_initializer(const std::string& name, const std::vector<int64_t>& values) {
+    auto* init = g_->add_initializer();
+    init->set_name(claim(name));
+    init->set_data_type(onnx::TensorProto::INT64);
+    init->add_dims(static_cast<int64_t>(values.size()));
+    for (auto v : values) init->add_int64_data(v);
+    return name;
+  }
+
+  std::string float_initializer(const std::string& name, const std::vector<float>& values) {
+    return initializer(name, torch::tensor(values), {static_cast<int64_t>(values.size())});
+  }
+
+  void emit(const graph::Op& op, const std::string& out) {
+    const auto in = [&](size_t i) { return names_.at(op.inputs.at(i)); };
+    switch (op.kind) {
+      case graph::OpKind::Conv: {
+        const auto& w = op.weight;
+        if (!w.defined() || w.dim() != 4 || w.size(2) != w.size(3))
+          throw Error(op_context(op.name), "conv weight must be [out, in/groups, k, k]");
+        std::vector<std::string> inputs = {in(0), initializer(op.name + ".weight", w, w.sizes().vec())};
+        if (op.bias.defined()) inputs.push_back(initializer(op.name + ".bias", op.bias, {w.size(0)}));
+        auto* n = node("Conv", op.name, inputs, {out});
+        attr(n, "kernel_shape", std::vector<int64_t>{w.size(2), w.size(3)});
+        attr(n, "pads", std::vector<int64_t>{op.padding, op.padding, op.padding, op.padding});
+        attr(n, "strides", std::vector<int64_t>{op.stride, op.stride});
+        attr(n, "dilations", std::vector<int64_t>{op.dilation, op.dilation});
+        attr(n, "group", op.groups);
+        return;
+      }
+      case graph::OpKind::Relu: node("Relu", op.name, {in(0)}, {out}); return;
+      case graph::OpKind::Sigmoid: node("Sigmoid", op.name, {in(0)}, {out}); return;
+      case graph::OpKind::LeakyRelu:
+        attr(node("LeakyRelu", op.name, {in(0)}, {out}), "alpha", op.negative_slope);
+        return;
+      case graph::OpKind::PixelShuffle: {
+        auto* n = node("DepthToSpace", op.name, {in(0)}, {out});
+        attr(n, "blocksize", op.factor);
+        attr(n, "mode", std::string("CRD"));
+        return;
+      }
+      case graph::OpKind::Resize: emit_resize(op, in(0), out); return;
+      case graph::OpKind::AvgPool: {
+        auto* n = node("AveragePool", op.name, {in(0)}, {out});
+        attr(n, "kernel_shape", std::vector<int64_t>{op.factor, op.factor});
+        attr(n, "strides", std::vector<int64_t>{op.factor, op.factor});
+        return;
+      }
+      case graph::OpKind::ChannelAffine: {
+        const int64_t c = graph::layout_width(graph_.values.at(op.inputs[0]).layout);
+        std::string x = in(0);
+        if (!op.scale.defined() && !op.shift.defined()) {
+          node("Identity", op.name, {x}, {out});
+          return;
+        }
+        if (op.scale.defined()) {
+          const std::string y = op.shift.defined() ? claim(op.name + ".scaled") : out;
+          node("Mul", op.name + (op.shift.defined() ? ".mul" : ""), {x, initializer(op.name + ".scale", op.scale, {1, c, 1, 1})},
+               {y});
+          x = y;
+        }
+        if (op.shift.defined())
+          node("Add", op.name + (op.scale.defined() ? ".add" : ""), {x, initializer(op.name + ".shift", op.shift, {1, c, 1, 1})},
+               {out});
+        return;
+      }
+      case graph::OpKind::Add: node("Add", op.name, {in(0), in(1)}, {out}); return;
+      case graph::OpKind::Mul: node("Mul", op.name, {in(0), in(1)}, {out}); return;
+      case graph::OpKind::Concat: {
+        std::vector<std::string> inputs;
+        for (size_t i = 0; i < op.inputs.size(); ++i) inputs.push_back(in(i));
+        attr(node("Concat", op.name, inputs, {out}), "axis", int64_t{1});
+        return;
+      }
+    }
+    throw Error(op_context(op.name), std::string("the ONNX writer does not know op kind '") +
+                                         graph::op_kind_name(op.kind) + "'");
+  }
+
+  void emit_resize(const graph::Op& op, const std::string& x, const std::string& out) {
+    if (op.factor < 1) throw Error(op_context(op.name), "resize factor must be >= 1");
+    if (op.mode == graph::ResizeMode::Bicubic && options_.cubic == CubicResize::Conv) {
+      emit_cubic_as_conv(op, x, out);
+      return;
+    }
+    const float f = static_cast<float>(op.factor);
+    const std::string scales = float_initializer(op.name + ".scales", {1.f, 1.f, f, f});
+    auto* n = node("Resize", op.name, {x, "", scales}, {out});
+    attr(n, "coordinate_transformation_mode", std::string("half_pixel"));
+    switch (op.mode) {
+      case graph::ResizeMode::Nearest:
+        // Source coordinate (j + 0.5) / f - 0.5 rounded half down = j div f: pixel replication.
+        attr(n, "mode", std::string("nearest"));
+        attr(n, "nearest_mode", std::string("round_prefer_floor"));
+        return;
+      case graph::ResizeMode::Bilinear: attr(n, "mode", std::string("linear")); return;
+      case graph::ResizeMode::Bicubic:
+        attr(n, "mode", std::string("cubic"));
+        attr(n, "cubic_coeff_a", kBicubicA);
+        attr(n, "exclude_outside", int64_t{0});
+        return;
+    }
+    throw Error(op_context(op.name), std::string("unknown resize mode ") + graph::resize_mode_name(op.mode));
+  }
+
+  // Bicubic upsampling as edge padding + a depthwise conv computing the f*f phases + DepthToSpace
+  // (bicubic_kernel.h). Exact up to float rounding, and runs wherever Conv and DepthToSpace run.
+  void emit_cubic_as_conv(const graph::Op& op, const std::string& x, const std::string& out) {
+    const int64_t c = graph::layout_width(graph_.values.at(op.inputs[0]).layout), f = op.factor;
+    const int64_t r = kBicubicPhaseRadius;
+    const std::string padded = claim(op.name + ".padded");
+    auto* pad = node("Pad", op.name + ".pad", {x, int64_initializer(op.name + ".pads", {0, 0, r, r, 0, 0, r, r})},
+                     {padded});
+    attr(pad, "mode", std::string("edge"));
+    const torch::Tensor kernel = bicubic_phase_kernels(f).repeat({c, 1, 1, 1});  // [c*f*f, 1, 5, 5]
+    const std::string phases = claim(op.name + ".phases");
+    auto* conv = node("Conv", op.name + ".conv", {padded, initializer(op.name + ".kernel", kernel, kernel.sizes().vec())},
+                      {phases});
+    attr(conv, "kernel_shape", std::vector<int64_t>{kernel.size(2), kernel.size(3)});
+    attr(conv, "pads", std::vector<int64_t>{0, 0, 0, 0});
+    attr(conv, "group", c);
+    auto* d2s = node("DepthToSpace", op.name, {phases}, {out});
+    attr(d2s, "blocksize", f);
+    attr(d2s, "mode", std::string("CRD"));
+  }
+
+  const graph::Graph& graph_;
+  const OnnxOptions& options_;
+  ExportSignature signature_;
+  onnx::ModelProto model_;
+  onnx::GraphProto* g_ = nullptr;
+  std::vector<std::string> names_;
+  std::set<std::string> used_;
+};
+
+onnx::ModelProto parse_model(const std::string& bytes, const std::string& context) {
+  onnx::ModelProto model;
+  if (bytes.empty()) throw Error(context, "empty file, not an ONNX model");
+  if (!model.ParseFromString(bytes)) throw Error(context, "not an ONNX model (the protobuf does not parse)");
+  return model;
+}
+
+void check_model(const onnx::ModelProto& model, const std::string& context) {
+  try {
+    onnx::checker::check_model(model);
+  } catch (const std::exception& e) {
+    throw Error(context, std::string("ONNX checker: ") + e.what());
+  }
+  try {
+    onnx::ModelProto copy = model;
+    onnx::ShapeInferenceOptions strict(/*check_type_val=*/true, /*strict_mode_val=*/1, /*data_prop_val=*/false);
+    onnx::shape_inference::InferShapes(copy, onnx::OpSchemaRegistry::Instance(), strict);
+  } catch (const std::exception& e) {
+    throw Error(context, std::string("ONNX shape inference: ") + e.what());
+  }
+}
+
+OnnxTensorInfo tensor_info(const onnx::ValueInfoProto& v) {
+  OnnxTensorInfo info;
+  info.name = v.name();
+  for (const auto& d : v.type().tensor_type().shape().dim()) {
+    OnnxDim dim;
+    if (d.has_dim_value()) dim.value = d.dim_value();
+    else dim.param = d.dim_param();
+    info.dims.push_back(dim);
+  }
+  return info;
+}
+
+}  // namespace
+
+std::string onnx_model_bytes(const graph::Graph& graph, const OnnxOptions& options) {
+  const onnx::ModelProto model = Writer(graph, options).build();
+  std::string bytes;
+  CGSR_CHECK(model.SerializeToString(&bytes), "onnx export: serialization failed");
+  check_model(model, "onnx export");
+  return bytes;
+}
+
+void write_onnx(const std::filesystem::path& path, const graph::Graph& graph, const OnnxOptions& options) {
+  write_file_atomic(path, onnx_model_bytes(graph, options));
+  check_onnx_file(path);
+}
+
+void check_onnx_bytes(const std::string& bytes, const std::string& context) {
+  check_model(parse_model(bytes, context), context);
+}
+
+void check_onnx_file(const std::filesystem::path& path) { check_onnx_bytes(read_file(path), path.string()); }
+
+bool OnnxModelInfo::dynamic() const {
+  for (const auto& in : inputs)
+    for (const auto& d : in.dims)
+      if (d.value < 0) return true;
+  return false;
+}
+
+const OnnxTensorInfo* OnnxModelInfo::find_input(const std::string& name) const {
+  for (const auto& in : inputs)
+    if (in.name == name) return &in;
+  return nullptr;
+}
+
+std::string OnnxModelInfo::metadata_value(const std::string& key) const {
+  for (const auto& [k, v] : metadata)
+    if (k == key) return v;
+  return "";
+}
+
+OnnxModelInfo inspect_onnx_file(const std::filesystem::path& path) {
+  const std::string context = path.string();
+  const onnx::ModelProto model = parse_model(read_file(path), context);
+  check_model(model, context);
+  OnnxModelInfo info;
+  for (const auto& opset : model.opset_import())
+    if (opset.domain().empty() || opset.domain() == "ai.onnx") info.opset = opset.version();
+  std::set<std::string> initializers;
+  for (const auto& init : model.graph().initializer()) initializers.insert(init.name());
+  for (const auto& in : model.graph().input())
+    if (!initializers.count(in.name())) info.inputs.push_back(tensor_info(in));
+  for (const auto& out : model.graph().output()) info.outputs.push_back(tensor_info(out));
+  for (const auto& n : model.graph().node()) {
+    bool found = false;
+    for (auto& [type, count] : info.op_counts)
+      if (type == n.op_type()) {
+        ++count;
+        found = true;
+      }
+    if (!found) info.op_counts.emplace_back(n.op_type(), 1);
+  }
+  for (const auto& p : model.metadata_props()) info.metadata.emplace_back(p.key(), p.value());
+  return info;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,119 @@
+#include "export/onnxruntime_runner.h"
+
+#include <torch/torch.h>
+
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/runtime.h"
+#include "export/raw_tensor.h"
+#include "export/subprocess.h"
+
+namespace cgsr {
+namespace {
+namespace fs = std::filesystem;
+
+const char* kInstallHint = "install it with scripts/install-deps.sh (npm install --ignore-scripts in tools/onnxruntime)";
+
+fs::path runner_dir() {
+  if (const char* env = std::getenv("CGSR_ONNXRUNTIME_DIR"); env && *env) return env;
+  return CGSR_ONNXRUNTIME_DIR;
+}
+
+std::string node_name() {
+  if (const char* env = std::getenv("CGSR_NODE"); env && *env) return env;
+  return "node";
+}
+
+std::string find_problem(const fs::path& dir) {
+  if (!find_executable(node_name())) return "Node.js ('" + node_name() + "') is not installed; " + kInstallHint;
+  if (!fs::exists(dir / "run.mjs")) return "the ONNX Runtime runner " + (dir / "run.mjs").string() + " is missing";
+  if (!fs::exists(dir / "node_modules" / "onnxruntime-node" / "package.json"))
+    return "the npm package onnxruntime-node is not installed in " + dir.string() + "; " + kInstallHint;
+  return "";
+}
+}  // namespace
+
+std::string OnnxRuntimeRunner::unavailable_reason() { return find_problem(runner_dir()); }
+
+OnnxRuntimeRunner::OnnxRuntimeRunner(int threads) : dir_(runner_dir()), threads_(threads > 0 ? threads : thread_count()) {
+  const std::string problem = find_problem(dir_);
+  if (!problem.empty()) throw Error("ONNX Runtime", problem);
+  node_ = *find_executable(node_name());
+}
+
+std::vector<OrtModelResult> OnnxRuntimeRunner::run(const std::vector<OrtModelJob>& jobs) const {
+  TempDir tmp("cgsr-ort");
+  nlohmann::ordered_json job;
+  job["threads"] = threads_;
+  job["models"] = nlohmann::ordered_json::array();
+  for (size_t m = 0; m < jobs.size(); ++m) {
+    nlohmann::ordered_json model;
+    model["path"] = fs::absolute(jobs[m].model).string();
+    model["runs"] = nlohmann::ordered_json::array();
+    for (size_t r = 0; r < jobs[m].runs.size(); ++r) {
+      const OrtRun& run = jobs[m].runs[r];
+      const std::string stem = "m" + std::to_string(m) + "_r" + std::to_string(r);
+      nlohmann::ordered_json entry;
+      entry["inputs"] = nlohmann::ordered_json::array();
+      for (const auto& [name, t] : run.inputs) {
+        const fs::path file = tmp.path() / (stem + "." + name + ".in.f32");
+        write_raw_float32(file, t);
+        entry["inputs"].push_back({{"name", name}, {"shape", t.sizes().vec()}, {"file", file.string()}});
+      }
+      entry["output_prefix"] = (tmp.path() / (stem + ".out")).string();
+      entry["warmup"] = run.warmup;
+      entry["repeats"] = run.repeats;
+      model["runs"].push_back(entry);
+    }
+    job["models"].push_back(model);
+  }
+  const fs::path job_file = tmp.path() / "job.json", result_file = tmp.path() / "result.json";
+  write_file_atomic(job_file, job.dump());
+  const ProcessResult p = run_process({node_.string(), (dir_ / "run.mjs").string(), job_file.string(),
+                                       result_file.string()});
+  if (p.exit_code != 0 || !fs::exists(result_file))
+    throw Error("ONNX Runtime", "the runner failed (exit " + std::to_string(p.exit_code) + "): " +
+                                    (p.err.empty() ? p.out : p.err));
+  nlohmann::json result;
+  try {
+    result = nlohmann::json::parse(read_file(result_file));
+  } catch (const nlohmann::json::exception& e) {
+    throw Error("ONNX Runtime", std::string("unreadable runner result: ") + e.what(), ErrorKind::Internal);
+  }
+  version_ = result.value("onnxruntime", "unknown");
+  std::vector<OrtModelResult> out;
+  const auto& models = result.at("models");
+  CGSR_CHECK(models.size() == jobs.size(), "ONNX Runtime runner returned a different number of models");
+  for (size_t m = 0; m < jobs.size(); ++m) {
+    const auto& entry = models[m];
+    OrtModelResult r;
+    r.model = jobs[m].model;
+    r.load_ms = entry.value("load_ms", 0.0);
+    if (!entry.at("error").is_null()) r.error = entry.at("error").get<std::string>();
+    if (r.error.empty()) {
+      CGSR_CHECK(entry.at("runs").size() == jobs[m].runs.size(), "ONNX Runtime runner skipped runs");
+      for (const auto& run : entry.at("runs")) {
+        OrtRunResult rr;
+        rr.times_ms = run.at("times_ms").get<std::vector<double>>();
+        for (const auto& o : run.at("outputs"))
+          rr.outputs.emplace_back(o.at("name").get<std::string>(),
+                                  read_raw_float32(o.at("file").get<std::string>(), o.at("shape").get<std::vector<int64_t>>()));
+        r.runs.push_back(std::move(rr));
+      }
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::vector<OrtModelResult> OnnxRuntimeRunner::run_checked(const std::vector<OrtModelJob>& jobs) const {
+  auto results = run(jobs);
+  for (const auto& r : results)
+    if (!r.error.empty()) throw Error(r.model.string(), "ONNX Runtime: " + r.error);
+  return results;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,19 @@
+#pragma once
+// Raw little-endian float32 files: the exchange format with the out-of-process runtimes
+// (ONNX Runtime in node, torch.jit.load in Python). The shape travels separately, in the job
+// description, so a file is exactly numel * 4 bytes.
+
+#include <torch/types.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace cgsr {
+
+void write_raw_float32(const std::filesystem::path& path, const torch::Tensor& tensor);
+
+// Throws cgsr::Error naming the file when its size is not that of `shape`.
+torch::Tensor read_raw_float32(const std::filesystem::path& path, const std::vector<int64_t>& shape);
+
+}  // namespace cgsr
