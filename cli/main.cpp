@@ -7,7 +7,16 @@
 #include <cstdio>
 
 #include "cli/command.h"
+#include "cli/commands/bench.h"
+#include "cli/commands/data_check.h"
 #include "cli/commands/info.h"
+#include "cli/commands/prune.h"
+#include "cli/commands/eval.h"
+#include "cli/commands/export.h"
+#include "cli/commands/render.h"
+#include "cli/commands/report.h"
+#include "cli/commands/search.h"
+#include "cli/commands/train.h"
 #include "core/error.h"
 #include "core/logging.h"
 
@@ -20,6 +29,15 @@ int main(int argc, char** argv) {
   add_global_options(app);
 
   setup_info(app);
+  setup_render(app);
+  setup_data(app);
+  setup_bench(app);
+  setup_train(app);
+  setup_eval(app);
+  setup_search(app);
+  setup_prune(app);
+  setup_report(app);
+  setup_export(app);
 
   try {
     app.parse(argc, argv);

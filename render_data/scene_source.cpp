@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include "render_data/procedural/procedural_scene.h"
 #include "render_data/q3/q3_scene_source.h"
 
 namespace cgsr {
@@ -14,8 +15,8 @@ Registry<SceneSourceFactory>& scene_sources() {
 void register_builtin_scene_sources() {
   static std::once_flag once;
   std::call_once(once, [] {
-    auto& r = scene_sources();
-    q3::register_q3_scene_source(r);
+    register_procedural_scene_source();
+    q3::register_q3_scene_source(scene_sources());
   });
 }
 

@@ -5,6 +5,7 @@
 #include <torch/types.h>
 
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,15 @@ class Upscaler {
   virtual torch::Tensor upscale(const Batch& batch) = 0;
   // Parameters and MACs at an LR size; nullopt for classic filters (the paper's "NA").
   virtual std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const { return std::nullopt; }
+
+  // Upscalers whose output depends on the previous frame (per-frame dynamic pruning reads its
+  // rendering information) say so; callers then pass that frame, with this upscaler's
+  // channels(), to previous_frame() before upscale() of the frame after it.
+  virtual bool uses_previous_frame() const { return false; }
+  virtual void previous_frame(const Batch& previous) {}
+  // What the last upscale() decided, for the per-frame record (e.g. the patterns a dynamically
+  // pruned network chose and the time spent choosing them); null when there is nothing to say.
+  virtual nlohmann::ordered_json frame_details() const { return nullptr; }
 };
 
 // nearest, bilinear, bicubic, lanczos, fsr

@@ -300,6 +300,26 @@ Vec3 point_at(const std::vector<Vec3>& line, const std::vector<double>& cum, dou
   return lerp(line[i - 1], line[i], seg > 0 ? static_cast<float>((s - cum[i - 1]) / seg) : 0.0f);
 }
 
+// A player looks where there is room to look: the heading turned by up to +-`search` degrees
+// (in 15-degree steps) towards the longest free line of sight, favouring small turns.
+Vec3 turn_towards_open_space(const BspCollision& collision, Vec3 eye, Vec3 look, float search) {
+  if (search <= 0) return look;
+  const float horizontal = std::hypot(look.x, look.y);
+  if (horizontal < 1e-3f) return look;
+  const float yaw = std::atan2(look.y, look.x);
+  constexpr float kRange = 2048;
+  float best_score = -1, best_turn = 0;
+  for (float turn = -search; turn <= search + 1e-3f; turn += 15.0f) {
+    const float a = yaw + turn / kDeg;
+    const Vec3 ray{std::cos(a) * horizontal, std::sin(a) * horizontal, look.z};
+    const float free = collision.trace(eye, eye + ray * kRange, Vec3{}).fraction * kRange;
+    const float score = std::min(free, 1024.0f) * (0.5f + 0.5f * std::cos(turn / kDeg));
+    if (score > best_score) best_score = score, best_turn = turn;
+  }
+  const float a = yaw + best_turn / kDeg;
+  return {std::cos(a) * horizontal, std::sin(a) * horizontal, look.z};
+}
+
 }  // namespace
 
 std::string CameraPathReport::summary() const {
@@ -386,7 +406,7 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
     positions[k] = point_at(line, cum, k * spacing);
     const Vec3 ahead = point_at(line, cum, k * spacing + o.look_ahead) - positions[k];
     if (length(ahead) >= 1.0f) last_direction = normalize(ahead);
-    looks[k] = last_direction;
+    looks[k] = turn_towards_open_space(collision, positions[k], last_direction, o.open_space_degrees);
   }
   // Heading: the look directions averaged over +-look_ahead (Gaussian), so corners are anticipated
   // and left gradually.

@@ -21,9 +21,10 @@
 // 5. Spline: centripetal Catmull-Rom through the route, sampled every key_spacing units; each
 //    span is checked sample to sample like a link. A span that touches something is retried with
 //    its tangents halved, then as the straight link (known to be clear).
-// 6. Orientation: look towards the point look_ahead units further along the path, averaged over
-//    the neighbouring keys and turning at a bounded rate, plus sine sways of yaw and pitch with
-//    seeded phases; pitch is clamped.
+// 6. Orientation: look towards the point look_ahead units further along the path, turned by up to
+//    open_space_degrees towards the longest free line of sight (players look down corridors, not
+//    into the corner they are about to turn), averaged over the neighbouring keys and turning at a
+//    bounded rate, plus sine sways of yaw and pitch with seeded phases; pitch is clamped.
 // Everything here is in Quake space (Z up, game units, yaw counter-clockwise from +X, pitch
 // positive up).
 
@@ -51,6 +52,7 @@ struct CameraPathOptions {
   float pitch_sway_degrees = 8, pitch_sway_period = 900;
   float max_pitch = 45;         // |pitch| limit, degrees
   float max_turn_rate = 0.6f;   // degrees of yaw per unit of travel (pitch: half of it)
+  float open_space_degrees = 45;  // the heading may turn this far towards a longer line of sight
   uint64_t seed = 0;
 };
 

@@ -6,6 +6,7 @@
 #include <torch/torch.h>
 
 #include <map>
+#include <set>
 
 #include "export/exporter.h"
 #include "export/verification.h"
@@ -16,11 +17,6 @@ namespace cgsr {
 namespace {
 
 constexpr int64_t kWidth = 12, kHeight = 10;
-
-struct Exported {
-  test::ExportCase c;
-  SRNetwork net{nullptr};
-};
 
 TEST(Verification, EveryNetworkMatchesOurForwardInEveryRuntime) {
   const auto dir = test::scratch_dir("export-verify");
@@ -58,6 +54,93 @@ TEST(Verification, EveryNetworkMatchesOurForwardInEveryRuntime) {
   EXPECT_EQ(ran["libtorch"], n);
   EXPECT_EQ(ran["python-torch"], n);
   EXPECT_TRUE(report.ok()) << report.table();
+  std::filesystem::remove_all(dir);
+}
+
+// Size-free files (dynamic ONNX, TorchScript) verify at two different sizes; OpenCV DNN is
+// skipped for dynamic ONNX with the reason.
+TEST(Verification, SizeFreeFilesMatchAtTwoSizes) {
+  const auto dir = test::scratch_dir("export-verify-dynamic");
+  const std::vector<test::ExportCase> chosen = {
+      {"pan_x3", default_spec("pan", 3)},
+      {"srcnn_x4_y", test::spec_for({"srcnn", 4, "y"})},
+      {"edsr_x2_rit_hr_pooled", test::with_rit(default_spec("edsr", 2), "hr_pooled", "concat")},
+      {"shrunk_pan_x4_rit_lr", test::with_rit(test::shrunk_pan(4), "lr", "add")},
+  };
+  std::vector<VerifyCase> cases;
+  uint64_t seed = 200;
+  for (const auto& c : chosen) {
+    SRNetwork net = test::build_network(c.spec, seed++);
+    ExportOptions o;
+    o.dynamic_size = true;
+    const auto onnx = export_network(*net, dir / (c.name + ".onnx"), o);
+    cases.push_back(make_verify_case(*net, onnx, {{kWidth, kHeight}, {7, 9}}, seed));
+    o.format = ExportFormat::TorchScript;
+    const auto ts = export_network(*net, dir / (c.name + ".pt"), o);
+    cases.push_back(make_verify_case(*net, ts, {{kWidth, kHeight}, {7, 9}}, seed));
+  }
+  const VerifyReport report = verify_exports(cases);
+  std::map<std::string, std::set<std::string>> sizes_by_runtime;
+  for (const auto& check : report.checks) {
+    SCOPED_TRACE(check.label + " in " + runtime_name(check.runtime) + " at " + check.input);
+    if (check.runtime == Runtime::OpenCvDnn) {
+      EXPECT_NE(check.skipped.find("fixed-size exports only"), std::string::npos) << check.skipped;
+      continue;
+    }
+    EXPECT_TRUE(check.ran && check.passed) << check.error << check.skipped;
+    EXPECT_LE(check.max_abs_error, 1e-4);
+    sizes_by_runtime[runtime_name(check.runtime)].insert(check.input);
+  }
+  for (const char* r : {"onnxruntime", "libtorch", "python-torch"})
+    EXPECT_EQ(sizes_by_runtime[r], (std::set<std::string>{"12x10", "7x9"})) << r;
+  EXPECT_EQ(report.skipped(), static_cast<int>(chosen.size()) * 2);  // OpenCV at both sizes
+  EXPECT_TRUE(report.ok());
+  std::filesystem::remove_all(dir);
+}
+
+// A native cubic Resize runs in ONNX Runtime; OpenCV DNN 4.6 cannot run it, which is why the conv
+// form is the default. The failure is reported per runtime with OpenCV's message.
+TEST(Verification, NativeCubicResizeRunsInOnnxRuntimeAndFailsClearlyInOpenCv) {
+  const auto dir = test::scratch_dir("export-verify-cubic");
+  SRNetwork net = test::build_network(test::spec_for({"srcnn", 3, "rgb"}), 300);
+  ExportOptions o;
+  o.width = kWidth;
+  o.height = kHeight;
+  o.cubic = CubicResize::Native;
+  const auto onnx = export_network(*net, dir / "srcnn_native.onnx", o);
+  const VerifyReport report = verify_exports({make_verify_case(*net, onnx, {{kWidth, kHeight}}, 1)});
+  ASSERT_EQ(report.checks.size(), 2u);
+  EXPECT_EQ(report.checks[0].runtime, Runtime::OnnxRuntime);
+  EXPECT_TRUE(report.checks[0].passed) << report.checks[0].error;
+  EXPECT_EQ(report.checks[1].runtime, Runtime::OpenCvDnn);
+  EXPECT_FALSE(report.checks[1].passed);
+  EXPECT_NE(report.checks[1].error.find("OpenCV"), std::string::npos) << report.checks[1].error;
+  EXPECT_FALSE(report.ok());
+  EXPECT_NE(report.table().find("FAILED"), std::string::npos);
+  EXPECT_EQ(report.to_json()["failed"], 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Verification, NamedRuntimesThatCannotRunAFileAreErrors) {
+  const auto dir = test::scratch_dir("export-verify-errors");
+  SRNetwork net = test::build_network(test::shrunk_edsr(2), 400);
+  ExportOptions o;
+  o.dynamic_size = true;
+  const auto onnx = export_network(*net, dir / "dynamic.onnx", o);
+  const VerifyCase c = make_verify_case(*net, onnx, {{6, 5}}, 1);
+  VerifyOptions opencv;
+  opencv.runtimes = {Runtime::OpenCvDnn};
+  try {
+    verify_exports({c}, opencv);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("fixed-size exports only"), std::string::npos) << e.what();
+  }
+  VerifyOptions libtorch;
+  libtorch.runtimes = {Runtime::LibTorch};
+  EXPECT_THROW(verify_exports({c}, libtorch), Error);
+  EXPECT_THROW(runtime_from_name("onnx-runtime"), Error);
+  EXPECT_EQ(runtime_from_name("opencv-dnn"), Runtime::OpenCvDnn);
   std::filesystem::remove_all(dir);
 }
 

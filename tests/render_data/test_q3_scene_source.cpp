@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <fstream>
+
 #include "core/color.h"
 #include "core/error.h"
 #include "render_data/camera.h"
@@ -11,6 +13,7 @@
 #include "render_data/renderer.h"
 #include "render_data/scene_source.h"
 #include "tests/render_data/q3_test_map.h"
+#include "tests/support/cli_runner.h"
 
 namespace cgsr::q3 {
 namespace {
@@ -213,6 +216,40 @@ TEST_F(Q3SceneSource, MissingGameDataNamesThePackagesAndTheInstallCommand) {
     EXPECT_NE(m.find("maps/tinx.bsp"), std::string::npos) << m;
     EXPECT_NE(m.find("did you mean 'tiny'"), std::string::npos) << m;
   }
+}
+
+TEST_F(Q3SceneSource, CgsrRenderWritesADatasetFromAQ3Config) {
+  const auto config = dir_.path() / "tiny_q3.yaml";
+  std::ofstream(config) << "name: tiny_q3\nframes: 3\nresolutions: [64x48, 128x96]\nshadows: false\n"
+                           "scene:\n  type: q3bsp\n  map: tiny\n  data_root: ''\n  pk3: ['"
+                        << pk3_.string() << "']\n  camera: {length: 200}\n";
+  const auto out = dir_.path() / "dataset";
+  const auto r = cgsr::test::run_cgsr("render --config " + config.string() + " --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out / "128x96" / "color" / "000002.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "64x48" / "depth" / "000000.exr"));
+  const std::string manifest = cgsr::test::slurp(out / "manifest.yaml");
+  EXPECT_NE(manifest.find("scene_source: q3bsp"), std::string::npos) << manifest;
+}
+
+// Every OpenArena scene config, pointed at a directory without the game: the error names the
+// packages and the command that installs them (whether or not this machine has them).
+TEST(Q3SceneConfigs, RenderWithoutTheGameDataSaysWhatToInstall) {
+  const auto configs = std::filesystem::path(CGSR_SOURCE_DIR) / "configs" / "scenes";
+  testing::TempDir dir;
+  int checked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(configs)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("oa_", 0) != 0) continue;
+    const auto r = cgsr::test::run_cgsr("render --config " + entry.path().string() + " --set scene.data_root=" +
+                                        (dir.path() / "no_game").string() + " --out " +
+                                        (dir.path() / name).string());
+    EXPECT_EQ(r.exit_code, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("openarena-088-data openarena-data"), std::string::npos) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("sudo apt-get install openarena-088-data openarena-data"), std::string::npos) << r.err;
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);
 }
 
 }  // namespace

@@ -57,3 +57,49 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 }
 
 }  // namespace cgsr::test
+
+#include <torch/torch.h>
+
+#include "render_data/dataset_manifest.h"
+#include "render_data/frame_files.h"
+#include "render_data/gbuffer.h"
+
+namespace cgsr::test {
+
+// A G-buffer filled with simple valid values: a plane at depth `depth` facing the camera.
+inline GBuffer flat_gbuffer(int W, int H, float depth = 5.0f) {
+  GBuffer g;
+  g.width = W;
+  g.height = H;
+  g.color = torch::rand({3, H, W});
+  g.depth = torch::full({1, H, W}, depth);
+  g.normal = torch::zeros({3, H, W});
+  g.normal[2].fill_(1.0f);
+  g.normal_angle = torch::zeros({1, H, W});
+  g.object_id = torch::zeros({1, H, W}, torch::kInt32);
+  g.material_id = torch::zeros({1, H, W}, torch::kInt32);
+  g.edge = torch::zeros({1, H, W});
+  g.motion = torch::zeros({2, H, W});
+  return g;
+}
+
+// Writes a complete dataset in the cgsr format; `make(frame, resolution)` gives each G-buffer.
+template <class Make>
+DatasetManifest write_test_dataset(const std::filesystem::path& dir, int frames, std::vector<Resolution> resolutions,
+                                   Make make, double near_plane = 0.1, double far_plane = 100.0) {
+  DatasetManifest m;
+  m.name = "synthetic";
+  m.complete = true;
+  m.fingerprint = "test";
+  m.frames = frames;
+  m.resolutions = resolutions;
+  m.near_plane = near_plane;
+  m.far_plane = far_plane;
+  m.split = make_split(frames);
+  for (int f = 0; f < frames; ++f)
+    for (const auto& r : resolutions) write_frame_files(dir, r, f, make(f, r));
+  write_manifest(dir, m);
+  return m;
+}
+
+}  // namespace cgsr::test

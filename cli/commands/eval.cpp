@@ -1,0 +1,95 @@
+#include "cli/commands/eval.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "core/atomic_file.h"
+#include "models/model_file.h"
+#include "pruning/hybrid_upscaler.h"
+#include "render_data/dataset.h"
+#include "train/report.h"
+
+namespace cgsr::cli {
+
+config::Schema<EvalCommandOptions> eval_schema() {
+  config::Schema<EvalCommandOptions> s;
+  s.field("data", &EvalCommandOptions::data, "data set directory").required();
+  s.field("models", &EvalCommandOptions::models,
+          "model files and classic upscalers (" + join(classic_upscalers().names()) + ", or 'classic' for all)")
+      .check([](const auto& v) { return !v.empty(); }, "needs at least one model or upscaler");
+  s.field("names", &EvalCommandOptions::names, "display names, in the order of models");
+  s.field("scale", &EvalCommandOptions::scale, "scale of the classic upscalers").range(2, 4);
+  s.section("eval", &EvalCommandOptions::eval, eval_schema_fields(), "what and how to evaluate");
+  s.validate([](const EvalCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.names.empty() && o.names.size() != o.models.size())
+      at.child("names").fail(node["names"] ? node["names"] : node, "needs one name per model");
+  });
+  add_run_settings(s);
+  return s;
+}
+
+std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale) {
+  if (classic_upscalers().contains(entry)) return classic_upscalers().get(entry)(scale);
+  if (!std::filesystem::exists(entry))
+    throw Error(entry, "neither a model file nor a classic upscaler (" + join(classic_upscalers().names()) + ")");
+  Model model = load_model(entry);
+  if (is_hybrid_model(model.provenance)) return make_hybrid_upscaler(entry, name);  // per-frame dynamic pruning
+  std::string display = name;
+  if (display.empty()) display = model.provenance.extra.value("name", std::filesystem::path(entry).stem().string());
+  return std::make_unique<NetworkUpscaler>(display, model.network);
+}
+
+void setup_eval(CLI::App& app) {
+  add_command<EvalCommandOptions>(
+      app, "eval", "Evaluate models and classic upscalers: PSNR, SSIM, temporal error, latency", eval_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        flag_to_key(sub, flags, "--data", "data", "data set directory");
+        sub.add_option_function<std::vector<std::string>>(
+            "--model",
+            [&flags](const std::vector<std::string>& models) {
+              std::string list = "[";
+              for (size_t i = 0; i < models.size(); ++i) list += (i ? ", " : "") + ("'" + models[i] + "'");
+              flags.push_back({"models=" + list + "]", "--model"});
+            },
+            "model file or classic upscaler name (repeatable; 'classic' = all classic upscalers)");
+        flag_to_key(sub, flags, "--split", "eval.split", "data set split");
+        flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");
+        flag_to_key(sub, flags, "--crop-border", "eval.crop_border", "HR pixels ignored at each border");
+        flag_to_key(sub, flags, "--save-frames", "eval.save_frames", "directory for upscaled frames");
+      },
+      [](const EvalCommandOptions& options, const YAML::Node&, RunDir* run_dir) { return run_eval(options, run_dir); },
+      /*always_run_dir=*/true);
+}
+
+nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir) {
+  const Dataset data = Dataset::open(options.data);
+  std::vector<std::pair<std::string, std::string>> entries;  // (model entry, display name)
+  for (size_t i = 0; i < options.models.size(); ++i) {
+    const std::string name = options.names.empty() ? "" : options.names[i];
+    if (options.models[i] == "classic") {
+      for (const auto& c : classic_upscalers().names()) entries.emplace_back(c, "");
+    } else {
+      entries.emplace_back(options.models[i], name);
+    }
+  }
+  std::vector<EvalResult> results;
+  nlohmann::ordered_json json;
+  json["data"] = data.info().root.string();
+  json["evaluations"] = nlohmann::ordered_json::array();
+  for (const auto& [entry, name] : entries) {
+    auto upscaler = make_upscaler(entry, name, options.scale);
+    EvalResult r = evaluate(*upscaler, data, options.eval);
+    spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f}{}", r.name, r.psnr, r.ssim,
+                 r.latency ? ", " + std::to_string(r.latency->median_ms) + " ms" : "");
+    if (run_dir) write_file_atomic(run_dir->file("frames_" + r.name + ".csv"), frames_csv(r));
+    json["evaluations"].push_back(to_json(r));
+    results.push_back(std::move(r));
+  }
+  const auto tables = group_results(results);
+  if (run_dir) write_file_atomic(run_dir->file("summary.csv"), report_csv(tables));
+  for (const auto& t : tables) std::printf("%s\n", report_markdown(t).c_str());
+  return json;
+}
+
+}  // namespace cgsr::cli

@@ -1,0 +1,34 @@
+#pragma once
+// `cgsr export`: writes a network as ONNX or TorchScript for other runtimes, optionally verified
+// in them (export/verification.h).
+//
+//   cgsr export --model pan --scale 2 --format onnx --input 320x240 --out pan_x2.onnx --verify
+//   cgsr export --model runs/train/model.cgsr --format torchscript --out model.pt
+//
+// --out here names the exported file (the command writes no run directory).
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "cli/command.h"
+
+namespace cgsr::cli {
+
+struct ExportCommandOptions : RunSettings {
+  std::string model;              // backbone name, spec YAML or model file
+  int scale = 0;                  // 0: the model file's scale, or 2 for a backbone name
+  std::string format = "onnx";    // onnx | torchscript
+  std::string input = "320x240";  // LR input size WxH (written into a fixed-size ONNX file)
+  bool dynamic_size = false;      // ONNX: symbolic batch, height and width
+  std::string cubic_resize = "conv";  // ONNX: bicubic resize as conv (portable) or native Resize
+  bool verify = false;            // run the file in the other runtimes and compare with our forward
+  double tolerance = 1e-4;        // max abs error allowed by --verify
+  std::string out;                // the file to write
+};
+
+config::Schema<ExportCommandOptions> export_schema();
+void setup_export(CLI::App& app);
+nlohmann::ordered_json run_export(const ExportCommandOptions& options);
+
+}  // namespace cgsr::cli

@@ -1,0 +1,40 @@
+#include "cli/commands/prune.h"
+
+#include "core/yaml_json.h"
+#include "render_data/dataset.h"
+
+namespace cgsr::cli {
+
+config::Schema<PruneCommandOptions> prune_command_schema() {
+  config::Schema<PruneCommandOptions> s;
+  s.field("model", &PruneCommandOptions::model, "trained model file to prune (e.g. the search result)").required();
+  s.field("data", &PruneCommandOptions::data, "data set directory of the scene").required();
+  add_prune_fields(s);
+  s.field("resume", &PruneCommandOptions::resume, "continue the fine-tuning from the run directory's checkpoints");
+  add_run_settings(s);
+  return s;
+}
+
+void setup_prune(CLI::App& app) {
+  add_command<PruneCommandOptions>(
+      app, "prune", "Rendering-aware hybrid pruning: dynamic pruning components, pattern pool, static pruning",
+      prune_command_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        flag_to_key(sub, flags, "--model", "model", "trained model file");
+        flag_to_key(sub, flags, "--data", "data", "data set directory");
+        flag_to_key(sub, flags, "--keep-rate", "pool.keep_rate", "fraction of each group's channels a pattern keeps");
+        flag_to_key(sub, flags, "--epochs", "finetune.epochs", "fine-tuning epochs");
+        switch_to_key(sub, flags, "--resume", "resume", "continue an interrupted run in --out");
+      },
+      [](const PruneCommandOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
+        return run_prune(options, resolved, *run_dir);
+      },
+      /*always_run_dir=*/true);
+}
+
+nlohmann::ordered_json run_prune(const PruneCommandOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
+  const Dataset data = Dataset::open(options.data);
+  return prune(options.model, data, options, run_dir.path(), options.resume, yaml_to_json(resolved));
+}
+
+}  // namespace cgsr::cli

@@ -1,0 +1,24 @@
+#pragma once
+// `cgsr prune`: hybrid pruning of a trained model for one scene (pruning/pruner.h). Writes
+// pruned.cgsr (the statically pruned network with its dynamic pruning components), mmp.cgsr (the
+// magnitude pruning baseline), pool.json, fine-tuning checkpoints (for --resume) and
+// results.json, whose `evaluations` (input model, baseline, static, hybrid) feed `cgsr report`.
+
+#include <CLI/CLI.hpp>
+
+#include "cli/command.h"
+#include "pruning/pruner.h"
+
+namespace cgsr::cli {
+
+struct PruneCommandOptions : RunSettings, PruneOptions {
+  std::string model;    // trained model file (required)
+  std::string data;     // data set directory (required)
+  bool resume = false;  // continue the fine-tuning from the run directory's checkpoints
+};
+
+config::Schema<PruneCommandOptions> prune_command_schema();
+void setup_prune(CLI::App& app);
+nlohmann::ordered_json run_prune(const PruneCommandOptions& options, const YAML::Node& resolved, RunDir& run_dir);
+
+}  // namespace cgsr::cli

@@ -1,0 +1,72 @@
+#include "cli/commands/report.h"
+
+#include <cstdio>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace cgsr::cli {
+
+config::Schema<ReportOptions> report_schema() {
+  config::Schema<ReportOptions> s;
+  s.field("runs", &ReportOptions::runs, "run directories or results.json files")
+      .check([](const auto& v) { return !v.empty(); }, "needs at least one run directory");
+  add_run_settings(s);
+  return s;
+}
+
+std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs) {
+  std::vector<EvalResult> out;
+  for (const auto& run : runs) {
+    std::filesystem::path file(run);
+    if (std::filesystem::is_directory(file)) file /= "results.json";
+    nlohmann::ordered_json j;
+    try {
+      j = nlohmann::ordered_json::parse(read_file(file));
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(file.string(), std::string("not valid JSON: ") + e.what());
+    }
+    if (!j.contains("evaluations") || !j["evaluations"].is_array())
+      throw Error(file.string(), "has no 'evaluations' (is it the results of cgsr eval or cgsr run?)");
+    for (size_t i = 0; i < j["evaluations"].size(); ++i)
+      out.push_back(eval_result_from_json(j["evaluations"][i], file.string() + ": evaluations[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+void setup_report(CLI::App& app) {
+  add_command<ReportOptions>(
+      app, "report", "Tabulate and plot evaluations: quality against params, MACs and latency", report_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        sub.add_option_function<std::vector<std::string>>(
+            "runs",
+            [&flags](const std::vector<std::string>& runs) {
+              std::string list = "[";
+              for (size_t i = 0; i < runs.size(); ++i) list += (i ? ", " : "") + ("'" + runs[i] + "'");
+              flags.push_back({"runs=" + list + "]", "RUN_DIRS"});
+            },
+            "run directories or results.json files");
+      },
+      [](const ReportOptions& options, const YAML::Node&, RunDir* run_dir) { return run_report(options, *run_dir); },
+      /*always_run_dir=*/true);
+}
+
+nlohmann::ordered_json run_report(const ReportOptions& options, RunDir& run_dir) {
+  const auto tables = group_results(collect_evaluations(options.runs));
+  std::string markdown;
+  nlohmann::ordered_json results;
+  results["tables"] = nlohmann::ordered_json::array();
+  for (const auto& t : tables) {
+    markdown += report_markdown(t) + "\n";
+    const std::string plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale) + ".png";
+    write_report_plot(run_dir.file(plot), t);
+    markdown += "![PSNR against latency](" + plot + ")\n\n";
+    results["tables"].push_back({{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}});
+  }
+  write_file_atomic(run_dir.file("report.md"), markdown);
+  write_file_atomic(run_dir.file("report.csv"), report_csv(tables));
+  std::printf("%s", markdown.c_str());
+  return results;
+}
+
+}  // namespace cgsr::cli

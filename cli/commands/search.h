@@ -1,0 +1,29 @@
+#pragma once
+// `cgsr search`: the CG-guided architecture search. Starts from a CG-enhanced model file, evolves
+// smaller specs (search/search_loop.h), trains the pick longer and writes it as model.cgsr.
+// history.jsonl records every candidate and is the checkpoint of --resume.
+
+#include <CLI/CLI.hpp>
+
+#include "cli/command.h"
+#include "cli/training_evaluator.h"
+#include "search/search_loop.h"
+
+namespace cgsr::cli {
+
+struct SearchCommandOptions : RunSettings {
+  std::string parent;  // CG-enhanced model file (required)
+  std::string data;    // data set directory (required)
+  SearchOptions search;
+  CandidateTraining candidate;
+  TrainSchedule final_schedule;  // training of the pick (paper: 30 epochs)
+  std::string name;              // display name of the result
+  bool resume = false;
+};
+
+config::Schema<SearchCommandOptions> search_command_schema();
+void setup_search(CLI::App& app);
+nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
+                                          RunDir& run_dir);
+
+}  // namespace cgsr::cli

@@ -1,0 +1,89 @@
+#include "cli/commands/train.h"
+
+#include <spdlog/spdlog.h>
+
+#include "core/yaml_json.h"
+#include "models/complexity.h"
+#include "models/inherit.h"
+#include "models/model_file.h"
+#include "models/model_source.h"
+#include "render_data/dataset.h"
+
+namespace cgsr::cli {
+
+config::Schema<TrainOptions> train_schema() {
+  config::Schema<EnhanceOptions> enhance;
+  enhance.field("enabled", &EnhanceOptions::enabled, "insert the RIT block (and geometry head) before training");
+  enhance.section("rit", &EnhanceOptions::rit, rit_spec_schema(), "rendering information transform block");
+  enhance.section("geometry", &EnhanceOptions::geometry, geometry_spec_schema(), "geometry head (training only)");
+
+  config::Schema<TrainOptions> s;
+  s.field("data", &TrainOptions::data, "data set directory (cgsr render output or a described capture)").required();
+  s.field("model", &TrainOptions::model, "backbone name, spec file or model file to start from");
+  s.field("scale", &TrainOptions::scale, "upscaling factor (must match a model file)").range(2, 4);
+  s.field("name", &TrainOptions::name, "display name in reports");
+  s.section("enhance", &TrainOptions::enhance, enhance, "make a CG-enhanced network");
+  s.section("schedule", &TrainOptions::schedule, schedule_schema(), "optimization schedule");
+  s.section("loss", &TrainOptions::loss, loss_schema(), "CGSR loss weights");
+  s.field("resume", &TrainOptions::resume, "continue from checkpoint.pt in the run directory");
+  add_run_settings(s);
+  return s;
+}
+
+void setup_train(CLI::App& app) {
+  add_command<TrainOptions>(
+      app, "train", "Train a backbone or a CG-enhanced network", train_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        flag_to_key(sub, flags, "--data", "data", "data set directory");
+        flag_to_key(sub, flags, "--model", "model", "backbone name, spec file or model file");
+        flag_to_key(sub, flags, "--steps", "schedule.steps", "optimizer steps");
+        switch_to_key(sub, flags, "--resume", "resume", "continue from the run directory's checkpoint");
+      },
+      [](const TrainOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
+        return run_train(options, resolved, *run_dir);
+      },
+      /*always_run_dir=*/true);
+}
+
+nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
+  const Dataset data = Dataset::open(options.data);
+  ModelSource source = resolve_model(options.model, options.scale);
+  SRNetwork network = source.network;
+  std::string stage = "backbone";
+  if (options.enhance.enabled) {
+    ArchSpec child = source.spec;
+    child.rit = options.enhance.rit;
+    child.rit.enabled = true;
+    child.geometry = options.enhance.geometry;
+    network = inherit(*source.network, resolve_spec(child)).network;
+    stage = "cg-enhanced";
+  }
+  const std::string name = options.name.empty() ? spec_summary(network->spec()) : options.name;
+  spdlog::info("training {} on {} ({} train / {} val frames)", name, data.info().root.string(),
+               data.frames(Split::Train).size(), data.frames(Split::Val).size());
+
+  Trainer trainer(network, data, options.schedule, options.loss);
+  const TrainOutcome outcome = trainer.run(run_dir.file("checkpoint.pt"), options.resume);
+
+  Provenance provenance;
+  provenance.stage = stage;
+  provenance.parent = source.kind == ModelSource::Kind::ModelFile ? options.model : "";
+  provenance.config = yaml_to_json(resolved);
+  provenance.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
+  provenance.extra = {{"name", name}, {"data", data.info().root.string()}};
+  save_model(run_dir.file("model.cgsr"), *network, provenance);
+  trainer.save_last_model(run_dir.file("last.cgsr"), provenance);
+
+  nlohmann::ordered_json results;
+  results["name"] = name;
+  results["stage"] = stage;
+  results["spec"] = spec_summary(network->spec());
+  results["params"] = inference_parameter_count(*network);
+  results["model"] = run_dir.file("model.cgsr").string();
+  results["training"] = to_json(outcome);
+  spdlog::info("{}: best validation {:.3f} dB / {:.4f} at step {}; {:.1f} patches/s", name, outcome.best.psnr,
+               outcome.best.ssim, outcome.best.step, outcome.patches_per_second);
+  return results;
+}
+
+}  // namespace cgsr::cli

@@ -1,0 +1,107 @@
+#include "cli/training_evaluator.h"
+
+#include <spdlog/spdlog.h>
+#include <torch/torch.h>
+
+#include <chrono>
+
+#include "core/runtime.h"
+#include "core/timing.h"
+#include "models/complexity.h"
+#include "models/inference.h"
+#include "models/inherit.h"
+#include "render_data/patch_sampler.h"
+#include "search/search_space.h"
+
+namespace cgsr::cli {
+
+config::Schema<CandidateTraining> candidate_training_schema() {
+  config::Schema<CandidateTraining> s;
+  s.field("fade_steps", &CandidateTraining::fade_steps,
+          "parent steps with an L1 penalty on the channels a candidate drops (0 = cut at once)")
+      .at_least(0);
+  s.section("schedule", &CandidateTraining::schedule, schedule_schema(), "training of each candidate");
+  s.section("loss", &CandidateTraining::loss, loss_schema(), "CGSR loss of candidate training");
+  s.field("measure_latency", &CandidateTraining::measure_latency, "time every candidate (for size_metric latency)");
+  return s;
+}
+
+namespace {
+// FNV-1a: a stable hash of the spec text, so a candidate's seed does not depend on evaluation order.
+uint64_t text_hash(const std::string& text) {
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+}  // namespace
+
+TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options)
+    : parent_(std::move(parent)), data_(data), options_(std::move(options)) {
+  const auto val = data_.frames(Split::Val).empty() ? data_.frames(Split::Train) : data_.frames(Split::Val);
+  const Batch b = frame_batch(data_, val.front(), parent_->spec().scale, {});
+  lr_width_ = b.lr_color.size(3);
+  lr_height_ = b.lr_color.size(2);
+}
+
+CandidateScore TrainingEvaluator::score(SRNetwork network, const ValidationScore& validation, double seconds) const {
+  CandidateScore s;
+  s.val_psnr = validation.psnr;
+  s.val_ssim = validation.ssim;
+  s.image_loss = validation.image_loss;
+  s.geometry_loss = validation.geometry_loss;
+  const Complexity cost = complexity(*network, lr_width_, lr_height_);
+  s.params = cost.params;
+  s.macs = cost.macs;
+  s.train_seconds = seconds;
+  if (options_.measure_latency) {
+    const auto color = torch::rand({1, 3, lr_height_, lr_width_});
+    const auto& spec = network->spec();
+    torch::Tensor info;
+    if (network->has_rit()) {
+      const int64_t f = spec.rit.source == "hr_pooled" ? spec.scale : 1;
+      info = torch::rand({1, spec.rit.info_width(), lr_height_ * f, lr_width_ * f});
+    }
+    s.latency_ms = measure_latency([&] { infer(*network, color, info); }, 2, 7).median_ms;
+  }
+  return s;
+}
+
+CandidateScore TrainingEvaluator::evaluate_parent() {
+  Trainer trainer(parent_, data_, options_.schedule, options_.loss);
+  return score(parent_, trainer.validate(0), 0.0);
+}
+
+CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
+  const auto started = std::chrono::steady_clock::now();
+  torch::manual_seed(global_seed() ^ text_hash(SearchSpace::key(spec)));
+
+  SRNetwork base = parent_;
+  if (options_.fade_steps > 0) {
+    // Fade on a copy of the parent (a child equal to its parent is a bit-identical copy).
+    SRNetwork faded = inherit(*parent_, parent_->spec()).network;
+    ShrinkTargets shrink;
+    const auto kept = inherit(*parent_, spec).kept;
+    const auto importance = parent_->channel_importance();
+    for (const auto& [group, keep] : kept) {
+      const auto it = importance.find(group);
+      if (it == importance.end()) continue;
+      std::vector<int64_t> dropped;
+      for (int64_t c = 0; c < it->second.size(0); ++c)
+        if (std::find(keep.begin(), keep.end(), c) == keep.end()) dropped.push_back(c);
+      if (!dropped.empty()) shrink[group] = dropped;
+    }
+    TrainSchedule fade = options_.schedule;
+    fade.steps = options_.fade_steps;
+    fade.validate_every = 0;
+    fade.val_frames = 1;
+    Trainer(faded, data_, fade, options_.loss, shrink).run();
+    base = faded;
+  }
+  SRNetwork child = inherit(*base, spec).network;
+  Trainer trainer(child, data_, options_.schedule, options_.loss);
+  const TrainOutcome outcome = trainer.run();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return score(child, outcome.best, seconds);
+}
+
+}  // namespace cgsr::cli

@@ -1,0 +1,271 @@
+#include "models/arch_spec.h"
+
+#include <algorithm>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/text.h"
+#include "models/backbone_registry.h"
+
+namespace cgsr {
+
+// ---- GroupWidths -------------------------------------------------------------------------------
+
+int GroupWidths::at(const std::string& group) const {
+  for (const auto& [name, width] : entries_)
+    if (name == group) return width;
+  std::vector<std::string> names;
+  for (const auto& e : entries_) names.push_back(e.first);
+  throw Error("arch spec", "no layer group '" + group + "'" + did_you_mean(group, names), ErrorKind::Internal);
+}
+
+bool GroupWidths::contains(const std::string& group) const {
+  for (const auto& e : entries_)
+    if (e.first == group) return true;
+  return false;
+}
+
+void GroupWidths::set(const std::string& group, int width) {
+  for (auto& e : entries_)
+    if (e.first == group) {
+      e.second = width;
+      return;
+    }
+  entries_.emplace_back(group, width);
+}
+
+namespace config {
+GroupWidths Codec<GroupWidths>::decode(const YAML::Node& node, const Cursor& at) {
+  if (!node.IsMap()) at.fail(node, "expected a map of layer group: width, got " + detail::describe(node));
+  GroupWidths widths;
+  for (const auto& kv : node) {
+    const auto key = kv.first.as<std::string>();
+    if (widths.contains(key)) at.child(key).fail(kv.first, "layer group '" + key + "' is listed twice");
+    widths.set(key, Codec<int>::decode(kv.second, at.child(key)));
+  }
+  return widths;
+}
+
+YAML::Node Codec<GroupWidths>::encode(const GroupWidths& widths) {
+  YAML::Node n(YAML::NodeType::Map);
+  for (const auto& [name, width] : widths.entries()) n[name] = width;
+  return n;
+}
+}  // namespace config
+
+// ---- spec --------------------------------------------------------------------------------------
+
+int ArchSpec::group_width(const std::string& group) const {
+  if (group == "rit") return rit.width;
+  if (group == "geometry") return geometry.width;
+  return widths.at(group);
+}
+
+std::vector<RenderChannel> ArchSpec::input_channels() const {
+  return rit.enabled ? rit.render_channels() : std::vector<RenderChannel>{};
+}
+
+namespace {
+
+struct Problem {
+  std::string key;  // dotted path of the offending key, e.g. "widths.block3_a"
+  std::string message;
+  bool at_key = false;  // the key itself is wrong (point at it, not at its value)
+};
+
+int effective_blocks(const ArchSpec& spec, const BackboneInfo& info) {
+  return spec.blocks < 0 ? info.default_blocks : spec.blocks;
+}
+
+// Everything wrong with a spec, resolved or not (missing blocks/widths mean defaults). Stops at
+// the first problem that makes later checks meaningless (unknown backbone, bad scale).
+std::vector<Problem> find_problems(const ArchSpec& spec) {
+  std::vector<Problem> problems;
+  const auto& registry = backbone_registry();
+  if (!registry.contains(spec.backbone)) {
+    problems.push_back({"backbone", "unknown backbone '" + spec.backbone + "'" +
+                                        did_you_mean(spec.backbone, registry.names()) +
+                                        "; valid: " + join(registry.names())});
+    return problems;
+  }
+  const BackboneInfo& info = registry.get(spec.backbone);
+  if (spec.scale < 2 || spec.scale > 4) {
+    problems.push_back({"scale", "scale must be 2, 3 or 4, got " + std::to_string(spec.scale)});
+    return problems;
+  }
+  if (spec.colors != "rgb" && spec.colors != "y")
+    problems.push_back({"colors", "'" + spec.colors + "' is not one of: rgb, y"});
+  else if (spec.colors == "y" && !info.supports_y)
+    problems.push_back({"colors", spec.backbone + " works on RGB only (colors: y is for srcnn)"});
+  if (spec.blocks >= 0 && (spec.blocks < info.min_blocks || spec.blocks > info.max_blocks))
+    problems.push_back({"blocks", info.max_blocks == 0
+                                      ? spec.backbone + " has no residual blocks; blocks must be 0"
+                                      : "blocks must be in [" + std::to_string(info.min_blocks) + ", " +
+                                            std::to_string(info.max_blocks) + "], got " +
+                                            std::to_string(spec.blocks)});
+  const int blocks = std::clamp(effective_blocks(spec, info), info.min_blocks, info.max_blocks);
+  std::vector<std::string> names;
+  for (const auto& g : info.groups(spec.scale, blocks)) names.push_back(g.name);
+  for (const auto& [group, width] : spec.widths.entries()) {
+    const std::string key = "widths." + group;
+    if (std::find(names.begin(), names.end(), group) == names.end()) {
+      std::string valid;
+      for (const auto& n : names)
+        if (n.rfind("block", 0) != 0) valid += (valid.empty() ? "" : ", ") + n;
+      for (const auto& suffix : info.block_group_suffixes)
+        valid += ", block<i>_" + suffix;
+      if (!info.block_group_suffixes.empty()) valid += " (i = 0.." + std::to_string(blocks - 1) + ")";
+      problems.push_back({key, "unknown layer group '" + group + "' for " + spec.backbone + " x" +
+                                   std::to_string(spec.scale) + " with " + std::to_string(blocks) + " blocks" +
+                                   did_you_mean(group, names) + "; groups: " + valid,
+                          /*at_key=*/true});
+    } else if (width < 1) {
+      problems.push_back({key, "width of layer group '" + group + "' must be at least 1, got " +
+                                   std::to_string(width)});
+    }
+  }
+  if (spec.rit.enabled && spec.rit.channels.empty())
+    problems.push_back({"rit.channels", "an enabled RIT needs at least one rendering channel"});
+  try {
+    parse_channels(spec.rit.channels);
+  } catch (const Error& e) {
+    problems.push_back({"rit.channels", e.message()});
+  }
+  if (spec.rit.width < 1)
+    problems.push_back({"rit.width", "must be at least 1, got " + std::to_string(spec.rit.width)});
+  if (spec.rit.source != "lr" && spec.rit.source != "hr_pooled")
+    problems.push_back({"rit.source", "'" + spec.rit.source + "' is not one of: lr, hr_pooled"});
+  if (spec.rit.fusion != "concat" && spec.rit.fusion != "add")
+    problems.push_back({"rit.fusion", "'" + spec.rit.fusion + "' is not one of: concat, add"});
+  if (spec.geometry.enabled && !spec.rit.enabled)
+    problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
+  if (spec.geometry.width < 1)
+    problems.push_back({"geometry.width", "must be at least 1, got " + std::to_string(spec.geometry.width)});
+  return problems;
+}
+
+// The YAML node of a dotted key's value (or of the key itself), else its deepest existing ancestor.
+YAML::Node locate_key(const YAML::Node& root, const std::string& key, bool at_key) {
+  YAML::Node node = root;
+  const auto parts = split(key, '.');
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (!node.IsMap()) break;
+    if (at_key && i + 1 == parts.size()) {
+      for (const auto& kv : node)
+        if (kv.first.as<std::string>() == parts[i]) return kv.first;
+      break;
+    }
+    const YAML::Node child = node[parts[i]];
+    if (!child) break;
+    node = child;
+  }
+  return node;
+}
+
+}  // namespace
+
+void validate_spec(const ArchSpec& spec) {
+  const auto problems = find_problems(spec);
+  if (!problems.empty()) throw Error("arch spec: " + problems.front().key, problems.front().message);
+  if (spec.blocks < 0) throw Error("arch spec: blocks", "unresolved (call resolve_spec)", ErrorKind::Internal);
+}
+
+ArchSpec resolve_spec(ArchSpec spec) {
+  const auto problems = find_problems(spec);
+  if (!problems.empty()) throw Error("arch spec: " + problems.front().key, problems.front().message);
+  const BackboneInfo& info = backbone_registry().get(spec.backbone);
+  if (spec.blocks < 0) spec.blocks = info.default_blocks;
+  GroupWidths widths;
+  for (const auto& g : info.groups(spec.scale, spec.blocks))
+    widths.set(g.name, spec.widths.contains(g.name) ? spec.widths.at(g.name) : g.width);
+  spec.widths = widths;
+  spec.rit.channels = channel_names(parse_channels(spec.rit.channels));
+  return spec;
+}
+
+ArchSpec default_spec(const std::string& backbone, int scale) {
+  ArchSpec spec;
+  spec.backbone = backbone;
+  spec.scale = scale;
+  return resolve_spec(spec);
+}
+
+std::vector<std::string> backbone_groups(const ArchSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& [name, width] : spec.widths.entries()) names.push_back(name);
+  return names;
+}
+
+config::Schema<RitSpec> rit_spec_schema() {
+  config::Schema<RitSpec> rit;
+  rit.field("enabled", &RitSpec::enabled, "insert the rendering information transform block");
+  rit.field("channels", &RitSpec::channels, "rendering channels the network reads (render_channels.h names)");
+  rit.field("width", &RitSpec::width, "features the RIT convolution produces").at_least(1);
+  rit.field("source", &RitSpec::source, "resolution of the rendering information").one_of({"lr", "hr_pooled"});
+  rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone").one_of({"concat", "add"});
+  return rit;
+}
+
+config::Schema<GeometrySpec> geometry_spec_schema() {
+  config::Schema<GeometrySpec> geometry;
+  geometry.field("enabled", &GeometrySpec::enabled, "training-only head predicting HR rendering information");
+  geometry.field("width", &GeometrySpec::width, "hidden width of the geometry head").at_least(1);
+  return geometry;
+}
+
+config::Schema<ArchSpec> arch_spec_schema() {
+  config::Schema<ArchSpec> s;
+  s.field("backbone", &ArchSpec::backbone, "backbone name (" + join(backbone_registry().names()) + ")");
+  s.field("scale", &ArchSpec::scale, "upscaling factor").range(2, 4);
+  s.field("colors", &ArchSpec::colors, "colour channels the network works on").one_of({"rgb", "y"});
+  s.field("blocks", &ArchSpec::blocks, "number of residual blocks (default: the backbone's)");
+  s.field("widths", &ArchSpec::widths, "width of each prunable layer group (default: the backbone's)");
+  s.section("rit", &ArchSpec::rit, rit_spec_schema(), "rendering information transform block");
+  s.section("geometry", &ArchSpec::geometry, geometry_spec_schema(), "geometry head (training only)");
+  s.validate([](const ArchSpec& spec, const config::Cursor& at, const YAML::Node& node) {
+    const auto problems = find_problems(spec);
+    if (problems.empty()) return;
+    const auto& p = problems.front();
+    config::Cursor where = at;
+    for (const auto& part : split(p.key, '.')) where = where.child(part);
+    where.fail(locate_key(node, p.key, p.at_key), p.message);
+  });
+  return s;
+}
+
+ArchSpec parse_spec(const YAML::Node& node, const config::Cursor& at) {
+  ArchSpec spec;
+  arch_spec_schema().parse(node, spec, at);
+  return resolve_spec(spec);
+}
+
+ArchSpec parse_spec(const config::Document& doc) { return parse_spec(doc.root(), config::Cursor{&doc, ""}); }
+
+ArchSpec load_spec_file(const std::filesystem::path& path) { return parse_spec(config::Document::load_file(path)); }
+
+ArchSpec spec_from_yaml(const std::string& text, const std::string& origin) {
+  return parse_spec(config::Document::parse(text, origin));
+}
+
+YAML::Node spec_to_node(const ArchSpec& spec) { return arch_spec_schema().emit(spec); }
+
+std::string spec_to_yaml(const ArchSpec& spec) { return config::to_yaml(spec_to_node(spec)); }
+
+void save_spec_file(const std::filesystem::path& path, const ArchSpec& spec) {
+  write_file_atomic(path, spec_to_yaml(spec));
+}
+
+std::string spec_summary(const ArchSpec& spec) {
+  std::string s = spec.backbone + " x" + std::to_string(spec.scale);
+  if (spec.colors == "y") s += " (Y)";
+  if (spec.rit.enabled) {
+    std::vector<std::string> channels = spec.rit.channels;
+    s += " + rit[" + join(channels, "+") + ", w" + std::to_string(spec.rit.width) + ", " + spec.rit.source + ", " +
+         spec.rit.fusion + "]";
+  }
+  if (spec.geometry.enabled) s += " + geometry head";
+  return s;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,135 @@
+#pragma once
+// The architecture spec (the "genome"): everything needed to build a network, and everything a
+// search may change. It is YAML-serializable with a config::Schema, so a spec file with a typo
+// fails with file:line:col and a suggestion.
+//
+//   backbone: pan            # a name in the backbone registry (backbone_registry.h)
+//   scale: 2                 # 2, 3 or 4
+//   colors: rgb              # rgb, or y (SRCNN only: the network sees BT.601 luma)
+//   blocks: 16               # residual blocks (PAN, EDSR); 0 for SRCNN
+//   widths:                  # width of every prunable layer group, by name
+//     features: 40
+//     block0_a: 20
+//     ...
+//   rit:                     # rendering information transform (rit.h)
+//     enabled: true
+//     channels: [depth, normal, normal_angle, edge]
+//     width: 16
+//     source: lr             # lr, or hr_pooled (HR rendering information pooled down)
+//     fusion: concat         # concat (feat + 1x1(cat(feat, rit))), or add (feat + 1x1(rit))
+//   geometry:                # training-only head predicting the HR rendering information
+//     enabled: true
+//     width: 16
+//
+// A layer group is a set of channels that must be kept or removed together: the outputs of
+// every layer writing into one residual stream, both operands of an attention product, the r*r
+// sub-pixel channels of a pixel shuffle. Widths are given per group, so a spec cannot describe
+// an inconsistent network; the group names of each backbone are listed by backbone_groups().
+// Missing `blocks` and `widths` entries take the backbone's defaults when parsed; a resolved
+// spec lists every group in the backbone's order.
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/config.h"
+#include "render_data/render_channels.h"
+
+namespace cgsr {
+
+// Width per layer group, in the backbone's canonical order.
+class GroupWidths {
+ public:
+  int at(const std::string& group) const;  // Error naming the group when absent
+  bool contains(const std::string& group) const;
+  void set(const std::string& group, int width);  // appends unknown groups
+  const std::vector<std::pair<std::string, int>>& entries() const { return entries_; }
+  bool empty() const { return entries_.empty(); }
+  bool operator==(const GroupWidths& o) const { return entries_ == o.entries_; }
+  bool operator!=(const GroupWidths& o) const { return !(*this == o); }
+
+ private:
+  std::vector<std::pair<std::string, int>> entries_;
+};
+
+struct RitSpec {
+  bool enabled = false;
+  std::vector<std::string> channels = {"depth", "normal", "normal_angle", "edge"};  // render_channels.h names
+  int width = 16;                 // features the RIT convolution produces (layer group "rit")
+  std::string source = "lr";      // lr | hr_pooled
+  std::string fusion = "concat";  // concat | add
+
+  std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
+  int info_width() const { return total_width(render_channels()); }
+  bool operator==(const RitSpec& o) const {
+    return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
+           fusion == o.fusion;
+  }
+};
+
+struct GeometrySpec {
+  bool enabled = false;
+  int width = 16;  // hidden width of the geometry head (layer group "geometry")
+  bool operator==(const GeometrySpec& o) const { return enabled == o.enabled && width == o.width; }
+};
+
+struct ArchSpec {
+  std::string backbone = "pan";
+  int scale = 2;
+  std::string colors = "rgb";  // rgb | y
+  int blocks = -1;             // -1 until resolved: the backbone's default
+  GroupWidths widths;
+  RitSpec rit;
+  GeometrySpec geometry;
+
+  // Width of any layer group: backbone groups, "rit" and "geometry".
+  int group_width(const std::string& group) const;
+  // Rendering channels the network takes as input (empty without RIT).
+  std::vector<RenderChannel> input_channels() const;
+  int color_channels() const { return colors == "y" ? 1 : 3; }
+
+  bool operator==(const ArchSpec& o) const {
+    return backbone == o.backbone && scale == o.scale && colors == o.colors && blocks == o.blocks &&
+           widths == o.widths && rit == o.rit && geometry == o.geometry;
+  }
+  bool operator!=(const ArchSpec& o) const { return !(*this == o); }
+};
+
+// The default spec of a backbone at a scale: the published architecture, no RIT, no head.
+ArchSpec default_spec(const std::string& backbone, int scale);
+
+// The layer groups of a (resolved) spec's backbone, in canonical order, without rit/geometry.
+std::vector<std::string> backbone_groups(const ArchSpec& spec);
+
+// Fills `blocks`, missing widths (defaults) and puts widths and rit.channels in canonical order.
+// Then validates. Throws Error("arch spec", ...) naming the offending key.
+ArchSpec resolve_spec(ArchSpec spec);
+void validate_spec(const ArchSpec& spec);
+
+// Schema binding for YAML; parse_spec() = parse + resolve + validate, errors at file:line:col.
+config::Schema<ArchSpec> arch_spec_schema();
+config::Schema<RitSpec> rit_spec_schema();
+config::Schema<GeometrySpec> geometry_spec_schema();
+ArchSpec parse_spec(const config::Document& doc);
+ArchSpec parse_spec(const YAML::Node& node, const config::Cursor& at);  // a spec nested in another config
+ArchSpec load_spec_file(const std::filesystem::path& path);
+ArchSpec spec_from_yaml(const std::string& text, const std::string& origin);
+YAML::Node spec_to_node(const ArchSpec& spec);
+std::string spec_to_yaml(const ArchSpec& spec);
+void save_spec_file(const std::filesystem::path& path, const ArchSpec& spec);  // atomic
+
+// "pan x2 + rit[depth+edge, w16, lr, concat]" for logs, tables and error contexts.
+std::string spec_summary(const ArchSpec& spec);
+
+namespace config {
+template <>
+struct Codec<GroupWidths> {
+  static GroupWidths decode(const YAML::Node& node, const Cursor& at);
+  static YAML::Node encode(const GroupWidths& widths);
+};
+}  // namespace config
+
+}  // namespace cgsr

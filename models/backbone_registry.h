@@ -1,0 +1,41 @@
+#pragma once
+// Backbones by name: what each one is (layer groups with their default widths, block range,
+// colour modes) and how to build it from a spec. Filled by register_builtin_backbones().
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/registry.h"
+#include "models/arch_spec.h"
+#include "models/backbone.h"
+
+namespace cgsr {
+
+struct GroupDefault {
+  std::string name;
+  int width = 0;
+};
+
+struct BackboneInfo {
+  std::string description;
+  int default_blocks = 0;
+  int min_blocks = 0;
+  int max_blocks = 0;
+  bool supports_y = false;  // may run on BT.601 luma (colors: y)
+  // Per-block groups are named "block<i>_<suffix>"; the suffixes, for error messages.
+  std::vector<std::string> block_group_suffixes;
+  // Every layer group of a network with this scale and block count, in canonical order.
+  std::function<std::vector<GroupDefault>(int scale, int blocks)> groups;
+  // Builds the backbone of a resolved, validated spec.
+  std::function<std::shared_ptr<BackboneImpl>(const ArchSpec& spec)> build;
+};
+
+const Registry<BackboneInfo>& backbone_registry();
+void register_builtin_backbones(Registry<BackboneInfo>& registry);
+
+// "block3_a"
+std::string block_group(int block, const std::string& suffix);
+
+}  // namespace cgsr

@@ -1,0 +1,181 @@
+#pragma once
+// An explicit, ordered description of a network's inference computation: the contract between
+// the models and everything that walks a network layer by layer (complexity counting,
+// inheritance, exporters to ONNX/TorchScript, pruning).
+//
+// A Graph is a list of Values (4-D NCHW tensors) and Ops in topological order. Every network
+// writes its graph by hand, op for op in the same order as its forward(); the interpreter run()
+// executes a graph with the very same kernels as the modules (the apply_* functions below), and
+// the tests check that run(graph) equals forward() bit for bit. Conv and ChannelAffine ops hold
+// the modules' own tensors (not copies), so a graph built from a network sees its current
+// weights, and writing into op.weight writes the parameter.
+//
+// Op semantics (inputs -> output; every op has exactly one output value):
+//   Conv           [x] -> conv2d(x, weight [out, in/groups, k, k], bias [out] or undefined,
+//                  stride, padding (zeros, same on all sides), dilation, groups).
+//                  `trainable` false marks fixed colour transforms (constants, no parameters:
+//                  EDSR's mean shift, SRCNN's luma conversion).
+//   Relu           [x] -> max(x, 0)
+//   LeakyRelu      [x] -> x >= 0 ? x : negative_slope * x
+//   Sigmoid        [x] -> 1 / (1 + exp(-x))
+//   PixelShuffle   [x] -> depth-to-space by `factor` r: input channel c*r*r + i*r + j goes to
+//                  output channel c at sub-pixel (i, j) (PyTorch PixelShuffle, ONNX
+//                  DepthToSpace mode CRD).
+//   Resize         [x] -> upsampling by the integer `factor` with `mode`, align_corners=False
+//                  (half-pixel centres: output pixel j samples input (j + 0.5) / factor - 0.5).
+//                  Nearest replicates each pixel factor x factor times. Bilinear and Bicubic
+//                  clamp sample indices at the border; Bicubic uses a = -0.75 (PyTorch, ONNX
+//                  Resize cubic_coeff_a=-0.75, exclude_outside=0). No antialiasing.
+//   AvgPool        [x] -> average over non-overlapping factor x factor windows (kernel = stride
+//                  = factor, no padding): area downsampling of an HR map to LR.
+//   ChannelAffine  [x] -> x * scale[c] + shift[c] per channel; scale or shift may be undefined
+//                  (then 1 or 0). Tensors have shape [C]. Used for the RIT gate (a trainable
+//                  scale).
+//   Add, Mul       [a, b] -> element-wise; operands have identical shapes (no broadcasting).
+//   Concat         [a, b, ...] -> concatenation along channels.
+//
+// Values carry a channel Layout: which prunable layer group (see arch_spec.h) owns each channel
+// position. Ops that tie channels together (Add, Mul) require identical layouts, so a graph can
+// only be built when widths are consistent through residual additions and attention products.
+// A pixel-shuffle producer's output axis has `repeat` r*r: position c*r*r + k belongs to channel
+// c of the group. Fixed axes (RGB, Y, rendering channels) are segments with prunable = false.
+//
+// Spatial sizes are kept as an integer `factor` relative to the LR input (the colour input has
+// factor 1, an HR rendering-information input has factor = scale), so one graph serves every
+// input size.
+
+#include <torch/types.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cgsr::graph {
+
+struct Segment {
+  std::string group;     // layer group name (prunable) or fixed axis name ("rgb", "y", "info:depth")
+  int64_t channels = 0;  // distinct channels of the group in this segment
+  int64_t repeat = 1;    // consecutive positions per channel (r*r before a pixel shuffle)
+  bool prunable = true;
+  bool operator==(const Segment& o) const {
+    return group == o.group && channels == o.channels && repeat == o.repeat && prunable == o.prunable;
+  }
+};
+using Layout = std::vector<Segment>;
+
+Layout group_layout(const std::string& group, int64_t channels, int64_t repeat = 1);  // prunable
+Layout fixed_layout(const std::string& name, int64_t channels);
+int64_t layout_width(const Layout& layout);
+std::string layout_string(const Layout& layout);  // "features(40) + rit(16)"
+
+struct Value {
+  std::string name;  // the producing op's name, or the graph input's name
+  Layout layout;
+  int64_t factor = 1;  // spatial size = factor x the LR input size
+};
+
+enum class OpKind { Conv, Relu, LeakyRelu, Sigmoid, PixelShuffle, Resize, AvgPool, ChannelAffine, Add, Mul, Concat };
+enum class ResizeMode { Nearest, Bilinear, Bicubic };
+
+const char* op_kind_name(OpKind kind);        // "conv", "leaky_relu", ...
+const char* resize_mode_name(ResizeMode mode);  // "nearest", "bilinear", "bicubic"
+
+struct Op {
+  OpKind kind = OpKind::Conv;
+  std::string name;         // unique; for ops with tensors, the module path of its parameters
+  std::vector<int> inputs;  // value indices
+  int output = -1;          // value index
+  // Conv
+  torch::Tensor weight, bias;
+  int64_t stride = 1, padding = 0, dilation = 1, groups = 1;
+  // Conv, ChannelAffine: tensors are the network's parameters (true) or constants (false)
+  bool trainable = true;
+  // LeakyRelu
+  double negative_slope = 0.0;
+  // PixelShuffle (upscale), Resize (scale), AvgPool (kernel = stride)
+  int64_t factor = 1;
+  ResizeMode mode = ResizeMode::Nearest;
+  // ChannelAffine
+  torch::Tensor scale, shift;
+
+  int64_t kernel_size() const { return weight.defined() ? weight.size(-1) : 0; }
+};
+
+struct Graph {
+  std::vector<Value> values;
+  std::vector<Op> ops;  // topological order
+  std::vector<std::pair<std::string, int>> inputs;   // "color" [N,3,h,w], "info" when the network uses it
+  std::vector<std::pair<std::string, int>> outputs;  // "image", and "geometry" for training graphs
+
+  int input(const std::string& name) const;   // value index; Error when absent
+  int output(const std::string& name) const;
+  bool has_input(const std::string& name) const;
+  bool has_output(const std::string& name) const;
+  const Op* find_op(const std::string& name) const;  // nullptr when absent
+};
+
+// Writes a graph. Names of ops made inside a Scope are prefixed "scope.". Every method checks
+// channel counts and layouts, so a mistake in a network's description fails at build time.
+class Builder {
+ public:
+  class Scope {
+   public:
+    Scope(Builder& b, const std::string& name);
+    ~Scope();
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    Builder& builder_;
+    size_t previous_;
+  };
+
+  Scope scope(const std::string& name) { return Scope(*this, name); }
+
+  int input(const std::string& name, Layout layout, int64_t factor);
+  void output(const std::string& name, int value);
+
+  // A conv whose weight is [out, in, k, k]; `out` must have width out.
+  int conv(const std::string& name, int x, const torch::Tensor& weight, const torch::Tensor& bias, int64_t padding,
+           Layout out, bool trainable = true);
+  int relu(int x);
+  int leaky_relu(int x, double negative_slope);
+  int sigmoid(int x);
+  int pixel_shuffle(int x, int64_t factor);
+  int resize(int x, int64_t factor, ResizeMode mode);
+  int avg_pool(int x, int64_t factor);
+  int affine(const std::string& name, int x, const torch::Tensor& scale, const torch::Tensor& shift, bool trainable);
+  int add(int a, int b);
+  int mul(int a, int b);
+  int concat(const std::vector<int>& parts);
+
+  const Value& value(int index) const { return graph_.values.at(index); }
+  Graph finish() { return std::move(graph_); }
+
+ private:
+  std::string qualified(const std::string& name) const;
+  std::string auto_name(OpKind kind) const;
+  int push(Op op, Value out);
+  Graph graph_;
+  std::string prefix_;
+};
+
+// The kernels modules and the interpreter share, so both compute identical bits.
+torch::Tensor apply_resize(const torch::Tensor& x, int64_t factor, ResizeMode mode);
+torch::Tensor apply_avg_pool(const torch::Tensor& x, int64_t factor);
+torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, const torch::Tensor& shift);
+
+// Called after each op with its index in graph.ops and its output; returns the value the later
+// ops see (the output itself, or e.g. a masked copy). Lets callers observe or adjust activations
+// (pruning: activation importance, per-sample channel patterns) without another interpreter.
+using OpObserver = std::function<torch::Tensor(size_t op_index, const torch::Tensor& output)>;
+
+// Executes the graph. `inputs` maps graph input names to tensors; returns every graph output.
+// With `op_ms`, also the wall time of each op in milliseconds (indexed like graph.ops).
+std::vector<std::pair<std::string, torch::Tensor>> run(
+    const Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
+    std::vector<double>* op_ms = nullptr, const OpObserver& observer = {});
+
+}  // namespace cgsr::graph

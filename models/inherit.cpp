@@ -1,0 +1,180 @@
+#include "models/inherit.h"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <numeric>
+#include <set>
+
+#include "core/error.h"
+#include "core/text.h"
+
+namespace cgsr {
+
+std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child) {
+  std::vector<std::string> p;
+  if (child.backbone != parent.backbone)
+    p.push_back("backbone " + child.backbone + " differs from the parent's " + parent.backbone);
+  if (child.scale != parent.scale)
+    p.push_back("scale x" + std::to_string(child.scale) + " differs from the parent's x" + std::to_string(parent.scale));
+  if (child.colors != parent.colors) p.push_back("colors " + child.colors + " differ from the parent's " + parent.colors);
+  if (!p.empty()) return p;
+  if (child.blocks > parent.blocks)
+    p.push_back("child has " + std::to_string(child.blocks) + " blocks, the parent only " +
+                std::to_string(parent.blocks));
+  for (const auto& [group, width] : child.widths.entries())
+    if (parent.widths.contains(group) && width > parent.widths.at(group))
+      p.push_back("layer group " + group + " is " + std::to_string(width) + " wide, the parent's only " +
+                  std::to_string(parent.widths.at(group)));
+  if (child.rit.enabled && parent.rit.enabled) {
+    if (child.rit.source != parent.rit.source)
+      p.push_back("rit.source " + child.rit.source + " differs from the parent's " + parent.rit.source);
+    if (child.rit.fusion != parent.rit.fusion)
+      p.push_back("rit.fusion " + child.rit.fusion + " differs from the parent's " + parent.rit.fusion);
+    for (const auto& c : child.rit.channels)
+      if (std::find(parent.rit.channels.begin(), parent.rit.channels.end(), c) == parent.rit.channels.end())
+        p.push_back("rit channel " + c + " is not read by the parent (" + join(parent.rit.channels) + ")");
+    if (child.rit.width > parent.rit.width)
+      p.push_back("rit.width " + std::to_string(child.rit.width) + " exceeds the parent's " +
+                  std::to_string(parent.rit.width));
+  }
+  if (child.geometry.enabled && parent.geometry.enabled && child.geometry.width > parent.geometry.width)
+    p.push_back("geometry.width " + std::to_string(child.geometry.width) + " exceeds the parent's " +
+                std::to_string(parent.geometry.width));
+  return p;
+}
+
+namespace {
+
+// Positions along a parent axis that make up the child axis, in child order.
+std::vector<int64_t> axis_indices(const graph::Layout& parent, const graph::Layout& child,
+                                  const std::map<std::string, std::vector<int64_t>>& kept, const std::string& what) {
+  std::vector<int64_t> out;
+  for (const auto& cs : child) {
+    int64_t offset = 0;
+    const graph::Segment* ps = nullptr;
+    for (const auto& s : parent) {
+      if (s.group == cs.group) {
+        ps = &s;
+        break;
+      }
+      offset += s.channels * s.repeat;
+    }
+    CGSR_CHECK(ps && ps->repeat == cs.repeat && ps->prunable == cs.prunable,
+               "inherit: " + what + ": channel group " + cs.group + " has no counterpart in the parent");
+    std::vector<int64_t> channels;
+    if (cs.prunable) {
+      channels = kept.at(cs.group);
+    } else {
+      CGSR_CHECK(ps->channels == cs.channels, "inherit: " + what + ": fixed axis " + cs.group + " changed size");
+      channels.resize(cs.channels);
+      std::iota(channels.begin(), channels.end(), 0);
+    }
+    CGSR_CHECK(static_cast<int64_t>(channels.size()) == cs.channels, "inherit: " + what + ": width of " + cs.group);
+    for (int64_t c : channels)
+      for (int64_t k = 0; k < cs.repeat; ++k) out.push_back(offset + c * cs.repeat + k);
+  }
+  return out;
+}
+
+torch::Tensor take(const torch::Tensor& t, int64_t dim, const std::vector<int64_t>& index) {
+  return t.index_select(dim, torch::tensor(index, torch::kLong));
+}
+
+// The channels of each group to keep: all of them when the width is unchanged (so an identical
+// child is an exact copy), else the most important ones in their original order.
+std::map<std::string, std::vector<int64_t>> choose_channels(const graph::Graph& parent, const graph::Graph& child,
+                                                            const std::map<std::string, std::vector<int64_t>>& given) {
+  const auto importance = channel_importance(parent);
+  std::map<std::string, int64_t> child_widths;
+  for (const auto& v : child.values)
+    for (const auto& s : v.layout)
+      if (s.prunable) child_widths[s.group] = s.channels;
+  std::map<std::string, std::vector<int64_t>> kept;
+  for (const auto& [group, width] : child_widths) {
+    const auto it = importance.find(group);
+    if (it == importance.end()) continue;  // a group the parent lacks (fresh RIT or head)
+    const auto chosen = given.find(group);
+    if (chosen != given.end()) {
+      const auto& c = chosen->second;
+      CGSR_CHECK(static_cast<int64_t>(c.size()) == width,
+                 "inherit: group " + group + " is " + std::to_string(width) + " wide but " + std::to_string(c.size()) +
+                     " channels were chosen");
+      for (size_t i = 0; i < c.size(); ++i)
+        CGSR_CHECK(c[i] >= 0 && c[i] < it->second.numel() && (i == 0 || c[i] > c[i - 1]),
+                   "inherit: chosen channels of group " + group + " must be increasing parent indices");
+      kept[group] = c;
+      continue;
+    }
+    const auto scores = it->second.detach().to(torch::kDouble).contiguous();
+    const int64_t n = scores.numel();
+    CGSR_CHECK(width <= n, "inherit: group " + group + " grows");
+    std::vector<int64_t> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    const double* s = scores.data_ptr<double>();
+    std::stable_sort(order.begin(), order.end(), [s](int64_t a, int64_t b) { return s[a] > s[b]; });
+    order.resize(width);
+    std::sort(order.begin(), order.end());
+    kept[group] = order;
+  }
+  return kept;
+}
+
+bool fresh_allowed(const std::string& name) { return name.rfind("rit.", 0) == 0 || name.rfind("geometry.", 0) == 0; }
+
+}  // namespace
+
+Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec) { return inherit(parent, child_spec, {}); }
+
+Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
+                    const std::map<std::string, std::vector<int64_t>>& kept) {
+  const ArchSpec child_spec = resolve_spec(child_spec_in);
+  const auto problems = inheritance_problems(parent.spec(), child_spec);
+  if (!problems.empty())
+    throw Error("inherit " + spec_summary(child_spec) + " from " + spec_summary(parent.spec()), join(problems, "; "));
+
+  Inheritance result;
+  result.network = SRNetwork(child_spec);
+  const graph::Graph pg = parent.describe(/*training=*/true);
+  const graph::Graph cg = result.network->describe(/*training=*/true);
+  for (const auto& [group, channels] : kept)
+    CGSR_CHECK(child_spec.widths.contains(group) || group == "rit" || group == "geometry",
+               "inherit: chosen channels for an unknown layer group " + group);
+  result.kept = choose_channels(pg, cg, kept);
+
+  torch::NoGradGuard no_grad;
+  std::set<const void*> assigned;
+  const auto copy = [&](const torch::Tensor& dst, const torch::Tensor& src, const std::string& what) {
+    CGSR_CHECK(dst.sizes() == src.sizes(), "inherit: " + what + " shape mismatch");
+    dst.copy_(src);
+    assigned.insert(dst.unsafeGetTensorImpl());
+  };
+  for (const auto& op : cg.ops) {
+    if (!op.trainable || (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine)) continue;
+    const graph::Op* pop = pg.find_op(op.name);
+    if (!pop) {
+      CGSR_CHECK(fresh_allowed(op.name), "inherit: the parent has no " + op.name);
+      continue;
+    }
+    const auto out = axis_indices(pg.values[pop->output].layout, cg.values[op.output].layout, result.kept,
+                                  op.name + " output");
+    if (op.kind == graph::OpKind::Conv) {
+      CGSR_CHECK(op.groups == 1 && pop->groups == 1, "inherit: grouped convs are not supported");
+      const auto in = axis_indices(pg.values[pop->inputs[0]].layout, cg.values[op.inputs[0]].layout, result.kept,
+                                   op.name + " input");
+      copy(op.weight, take(take(pop->weight, 0, out), 1, in), op.name + ".weight");
+      if (op.bias.defined()) copy(op.bias, take(pop->bias, 0, out), op.name + ".bias");
+    } else {
+      if (op.scale.defined()) copy(op.scale, take(pop->scale, 0, out), op.name + " scale");
+      if (op.shift.defined()) copy(op.shift, take(pop->shift, 0, out), op.name + " shift");
+    }
+  }
+  for (const auto& p : result.network->named_parameters(/*recurse=*/true)) {
+    if (assigned.count(p.value().unsafeGetTensorImpl())) continue;
+    CGSR_CHECK(fresh_allowed(p.key()), "inherit: parameter " + p.key() + " is not described by the graph");
+    result.fresh.push_back(p.key());
+  }
+  return result;
+}
+
+}  // namespace cgsr

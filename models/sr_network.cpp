@@ -1,0 +1,173 @@
+#include "models/sr_network.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+#include "core/tensor_checks.h"
+#include "core/text.h"
+#include "models/backbone_registry.h"
+
+namespace cgsr {
+
+SRNetworkImpl::SRNetworkImpl(const ArchSpec& spec) : spec_(resolve_spec(spec)) {
+  backbone_ = register_module("backbone", backbone_registry().get(spec_.backbone).build(spec_));
+  if (spec_.rit.enabled)
+    rit_ = register_module("rit", RitBlock(spec_.rit, spec_.scale, backbone_->feature_group(),
+                                           spec_.group_width(backbone_->feature_group()),
+                                           backbone_->feature_factor()));
+  if (spec_.geometry.enabled)
+    geometry_ = register_module("geometry", GeometryHead(spec_.group_width(backbone_->hr_feature_group()),
+                                                         spec_.geometry.width, spec_.input_channels()));
+}
+
+void SRNetworkImpl::check_inputs(const torch::Tensor& lr_color, const torch::Tensor& info) const {
+  const std::string context = spec_summary(spec_);
+  if (!lr_color.defined() || lr_color.dim() != 4 || lr_color.size(1) != 3)
+    throw Error(context, "colour input must be [N, 3, h, w], got " +
+                             (lr_color.defined() ? shape_string(lr_color) : std::string("nothing")));
+  if (!has_rit()) return;
+  const int64_t c = spec_.rit.info_width(), f = rit_->info_factor();
+  const std::vector<int64_t> want = {lr_color.size(0), c, lr_color.size(2) * f, lr_color.size(3) * f};
+  if (!info.defined() || info.sizes().vec() != want)
+    throw Error(context, "rendering information (" + join(spec_.rit.channels) + ", " +
+                             (f > 1 ? "HR" : "LR") + " size) must be " + shape_string(torch::empty(want)) +
+                             ", got " + (info.defined() ? shape_string(info) : std::string("nothing")));
+}
+
+torch::Tensor SRNetworkImpl::forward(const torch::Tensor& lr_color, const torch::Tensor& info) {
+  check_inputs(lr_color, info);
+  const auto extracted = backbone_->extract(lr_color);
+  const auto features = has_rit() ? rit_->forward(extracted.features, info) : extracted.features;
+  return backbone_->reconstruct(features, extracted.skip).image;
+}
+
+TrainOutput SRNetworkImpl::forward_train(const torch::Tensor& lr_color, const torch::Tensor& info) {
+  check_inputs(lr_color, info);
+  const auto extracted = backbone_->extract(lr_color);
+  const auto features = has_rit() ? rit_->forward(extracted.features, info) : extracted.features;
+  const auto recon = backbone_->reconstruct(features, extracted.skip);
+  return {recon.image, has_geometry_head() ? geometry_->forward(recon.hr_features) : torch::Tensor()};
+}
+
+namespace {
+// The rows of `info` (stacked in `available` order) holding `wanted`, in `wanted` order.
+torch::Tensor select_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
+                              const std::vector<RenderChannel>& wanted, const std::string& what) {
+  if (!info.defined() || info.dim() != 4 || info.size(1) != total_width(available))
+    throw Error("batch", what + " must be [N, " + std::to_string(total_width(available)) + ", H, W] for channels " +
+                             join(channel_names(available)) + ", got " +
+                             (info.defined() ? shape_string(info) : std::string("nothing")));
+  std::vector<torch::Tensor> parts;
+  for (auto c : wanted) {
+    int64_t offset = 0;
+    bool found = false;
+    for (auto a : available) {
+      if (a == c) {
+        found = true;
+        break;
+      }
+      offset += channel_width(a);
+    }
+    if (!found)
+      throw Error("batch", "the model needs rendering channel '" + channel_name(c) + "' but the batch has only " +
+                               (available.empty() ? std::string("none") : join(channel_names(available))));
+    parts.push_back(info.slice(1, offset, offset + channel_width(c)));
+  }
+  return torch::cat(parts, 1);
+}
+}  // namespace
+
+torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
+  if (!has_rit()) return {};
+  if (batch.scale != spec_.scale)
+    throw Error("batch", "scale x" + std::to_string(batch.scale) + " does not match the model's x" +
+                             std::to_string(spec_.scale));
+  const bool hr = spec_.rit.source == "hr_pooled";
+  return select_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
+                         hr ? "hr_info" : "lr_info");
+}
+
+torch::Tensor SRNetworkImpl::geometry_target(const Batch& batch) const {
+  if (!has_geometry_head()) return {};
+  return select_channels(batch.hr_info, batch.channels, input_channels(), "hr_info");
+}
+
+graph::Graph SRNetworkImpl::describe(bool training) const {
+  graph::Builder g;
+  const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
+  const int info = has_rit() ? g.input("info", info_layout(input_channels()), rit_->info_factor()) : -1;
+  ExtractedPorts extracted;
+  {
+    auto scope = g.scope("backbone");
+    extracted = backbone_->describe_extract(g, color);
+  }
+  int features = extracted.features;
+  if (has_rit()) {
+    auto scope = g.scope("rit");
+    features = rit_->describe(g, features, info);
+  }
+  ReconstructionPorts recon;
+  {
+    auto scope = g.scope("backbone");
+    recon = backbone_->describe_reconstruct(g, features, extracted.skip);
+  }
+  g.output("image", recon.image);
+  if (training && has_geometry_head()) {
+    auto scope = g.scope("geometry");
+    g.output("geometry", geometry_->describe(g, recon.hr_features));
+  }
+  return g.finish();
+}
+
+torch::Tensor SRNetworkImpl::rit_gate() const { return has_rit() ? rit_->gate : torch::Tensor(); }
+
+std::map<std::string, torch::Tensor> SRNetworkImpl::channel_importance() const {
+  return cgsr::channel_importance(describe(false));
+}
+
+std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph) {
+  std::map<std::string, torch::Tensor> out;
+  for (const auto& op : graph.ops) {
+    if (!op.trainable) continue;
+    // Per output position: |weights| and |bias| of the conv, |scale| and |shift| of an affine.
+    torch::Tensor per_position;
+    if (op.kind == graph::OpKind::Conv) {
+      per_position = op.weight.abs().sum({1, 2, 3});
+      if (op.bias.defined()) per_position = per_position + op.bias.abs();
+    } else if (op.kind == graph::OpKind::ChannelAffine) {
+      per_position = op.scale.defined() ? op.scale.abs() : torch::zeros({op.shift.numel()});
+      if (op.shift.defined()) per_position = per_position + op.shift.abs();
+    } else {
+      continue;
+    }
+    int64_t offset = 0;
+    for (const auto& s : graph.values[op.output].layout) {
+      const int64_t span = s.channels * s.repeat;
+      if (s.prunable) {
+        const auto channel = per_position.slice(0, offset, offset + span).view({s.channels, s.repeat}).sum(1);
+        auto it = out.find(s.group);
+        if (it == out.end())
+          out.emplace(s.group, channel);
+        else
+          it->second = it->second + channel;
+      }
+      offset += span;
+    }
+  }
+  return out;
+}
+
+int64_t total_parameter_count(const SRNetworkImpl& net) {
+  int64_t n = 0;
+  for (const auto& p : net.parameters(/*recurse=*/true)) n += p.numel();
+  return n;
+}
+
+int64_t inference_parameter_count(const SRNetworkImpl& net) {
+  int64_t n = 0;
+  for (const auto& p : net.named_parameters(/*recurse=*/true))
+    if (p.key().rfind("geometry.", 0) != 0) n += p.value().numel();
+  return n;
+}
+
+}  // namespace cgsr

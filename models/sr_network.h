@@ -1,0 +1,86 @@
+#pragma once
+// The one network type every stage uses: a backbone, optionally the RIT block between its
+// feature extraction and reconstruction, and optionally the training-only geometry head.
+// Built from an ArchSpec; registered module names ("backbone.", "rit.", "geometry.") are the
+// keys of model files.
+//
+//   SRNetwork net(default_spec("pan", 2));
+//   auto sr = net->forward(lr_color);                 // [N, 3, 2h, 2w]
+//   auto out = net->forward_train(lr_color, info);    // {image, geometry}
+//   loss += lambda_r * net->rit_gate().abs().sum();   // the paper's sum ||R_i||
+//   auto imp = net->channel_importance();             // group -> [width], differentiable
+//   loss += lambda_s * imp.at("block3_a").index_select(0, shrink).sum();   // sum ||S_k||
+//
+// `info` holds the spec's rendering channels (rit.channels, in render_channels.h order) at LR
+// size for rit.source lr, at HR size for hr_pooled; it may be undefined without a RIT. Resizes
+// follow align_corners=False (graph.h).
+
+#include <torch/nn/module.h>
+#include <torch/types.h>
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "models/arch_spec.h"
+#include "models/backbone.h"
+#include "models/geometry_head.h"
+#include "models/graph.h"
+#include "models/rit.h"
+#include "render_data/batch.h"
+
+namespace cgsr {
+
+struct TrainOutput {
+  torch::Tensor image;     // [N, 3, s*h, s*w]
+  torch::Tensor geometry;  // [N, C, s*h, s*w] predicted HR rendering information; undefined without head
+};
+
+class SRNetworkImpl : public torch::nn::Module {
+ public:
+  explicit SRNetworkImpl(const ArchSpec& spec);  // resolves and validates the spec
+
+  torch::Tensor forward(const torch::Tensor& lr_color, const torch::Tensor& info = {});
+  TrainOutput forward_train(const torch::Tensor& lr_color, const torch::Tensor& info = {});
+
+  // What the network takes from a Batch: its rendering channels at the resolution the spec asks
+  // for (undefined without RIT), and the target of the geometry head (the HR channels).
+  torch::Tensor info_input(const Batch& batch) const;
+  torch::Tensor geometry_target(const Batch& batch) const;
+
+  // The inference graph (graph.h): inputs "color" (+ "info" with RIT), output "image". With
+  // `training`, also the geometry head and its output "geometry".
+  graph::Graph describe(bool training = false) const;
+
+  // The RIT gate R [C] (a parameter; undefined without RIT).
+  torch::Tensor rit_gate() const;
+  // Per prunable layer group of the inference network (backbone groups and "rit"): the L1 norm
+  // of the weights (and biases) producing each channel, differentiable. Pixel-shuffle groups sum
+  // their r*r sub-channels.
+  std::map<std::string, torch::Tensor> channel_importance() const;
+
+  const ArchSpec& spec() const { return spec_; }
+  std::vector<RenderChannel> input_channels() const { return spec_.input_channels(); }
+  BackboneImpl& backbone() const { return *backbone_; }
+  bool has_rit() const { return !rit_.is_empty(); }
+  bool has_geometry_head() const { return !geometry_.is_empty(); }
+  RitBlock rit() const { return rit_; }
+  GeometryHead geometry_head() const { return geometry_; }
+
+ private:
+  void check_inputs(const torch::Tensor& lr_color, const torch::Tensor& info) const;
+  ArchSpec spec_;
+  std::shared_ptr<BackboneImpl> backbone_;
+  RitBlock rit_{nullptr};
+  GeometryHead geometry_{nullptr};
+};
+TORCH_MODULE(SRNetwork);
+
+// Importance of each channel of every prunable group produced in `graph` (see channel_importance).
+std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph);
+
+// Trainable parameters: all of them, and those of the inference network (no geometry head).
+int64_t total_parameter_count(const SRNetworkImpl& net);
+int64_t inference_parameter_count(const SRNetworkImpl& net);
+
+}  // namespace cgsr

@@ -1,0 +1,31 @@
+#pragma once
+// How much each channel of the pruning units matters for one input (a training frame): the
+// per-frame ranking that frequency-based sorting (pattern_pool.h) counts.
+//
+//   taylor      |sum over the values carrying c (as convolution inputs) of sum_pixels a * dL/da|:
+//               the first-order change of the reconstruction loss L (mean squared error to the
+//               HR frame) when channel c is removed from the frame (Molchanov et al. 2017)
+//   activation  mean |a| of the channel over those values and pixels (no backward pass)
+
+#include <string>
+#include <vector>
+
+#include "models/sr_network.h"
+#include "pruning/pattern_pool.h"
+#include "pruning/prunable_units.h"
+#include "render_data/batch.h"
+
+namespace cgsr {
+
+enum class ImportanceMethod { Taylor, Activation };
+ImportanceMethod importance_method_from_name(const std::string& name);  // taylor | activation
+
+// For every group of `units`: importance [width] (CPU float) under the batch (summed over items).
+FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<PrunableUnit>& units,
+                                 ImportanceMethod method);
+
+// Op indices whose outputs feed a convolution and carry channels of `units`' groups: the values
+// where removing a channel takes effect (masks and importance apply there).
+std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::vector<PrunableUnit>& units);
+
+}  // namespace cgsr

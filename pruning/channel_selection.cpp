@@ -1,0 +1,115 @@
+#include "pruning/channel_selection.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+
+namespace cgsr {
+
+namespace {
+const std::vector<int64_t>* find_kept(const ChannelSelection& keep, const graph::Segment& s) {
+  if (!s.prunable) return nullptr;
+  const auto it = keep.find(s.group);
+  return it == keep.end() ? nullptr : &it->second;
+}
+
+torch::Tensor take(const torch::Tensor& t, int64_t dim, const std::vector<int64_t>& index) {
+  return t.index_select(dim, torch::tensor(index, torch::kLong)).contiguous();
+}
+
+bool narrows(const graph::Layout& layout, const ChannelSelection& keep) {
+  for (const auto& s : layout)
+    if (const auto* k = find_kept(keep, s); k && static_cast<int64_t>(k->size()) != s.channels) return true;
+  return false;
+}
+}  // namespace
+
+std::vector<int64_t> selected_positions(const graph::Layout& layout, const ChannelSelection& keep) {
+  std::vector<int64_t> out;
+  int64_t offset = 0;
+  for (const auto& s : layout) {
+    if (const auto* k = find_kept(keep, s)) {
+      for (int64_t c : *k)
+        for (int64_t r = 0; r < s.repeat; ++r) out.push_back(offset + c * s.repeat + r);
+    } else {
+      for (int64_t p = 0; p < s.channels * s.repeat; ++p) out.push_back(offset + p);
+    }
+    offset += s.channels * s.repeat;
+  }
+  return out;
+}
+
+graph::Layout selected_layout(const graph::Layout& layout, const ChannelSelection& keep) {
+  graph::Layout out = layout;
+  for (auto& s : out)
+    if (const auto* k = find_kept(keep, s)) s.channels = static_cast<int64_t>(k->size());
+  return out;
+}
+
+std::vector<std::pair<std::string, int64_t>> group_widths(const graph::Graph& graph) {
+  std::vector<std::pair<std::string, int64_t>> out;
+  for (const auto& v : graph.values)
+    for (const auto& s : v.layout) {
+      if (!s.prunable) continue;
+      bool seen = false;
+      for (const auto& [g, w] : out) seen = seen || g == s.group;
+      if (!seen) out.emplace_back(s.group, s.channels);
+    }
+  return out;
+}
+
+void check_selection(const graph::Graph& graph, const ChannelSelection& keep, const std::string& context) {
+  const auto widths = group_widths(graph);
+  for (const auto& [group, channels] : keep) {
+    int64_t width = -1;
+    for (const auto& [g, w] : widths)
+      if (g == group) width = w;
+    if (width < 0) throw Error(context, "no prunable layer group '" + group + "' in the network");
+    if (channels.empty()) throw Error(context, "layer group " + group + " would keep no channel");
+    for (size_t i = 0; i < channels.size(); ++i)
+      if (channels[i] < 0 || channels[i] >= width || (i > 0 && channels[i] <= channels[i - 1]))
+        throw Error(context, "channels of layer group " + group + " must be increasing indices below " +
+                                 std::to_string(width));
+  }
+}
+
+SelectedTensors select_op_tensors(const graph::Graph& graph, const graph::Op& op, const ChannelSelection& keep) {
+  SelectedTensors t{op.weight, op.bias, op.scale, op.shift};
+  const auto& out_layout = graph.values[op.output].layout;
+  const bool out_narrows = narrows(out_layout, keep);
+  if (op.kind == graph::OpKind::Conv) {
+    const auto& in_layout = graph.values[op.inputs[0]].layout;
+    const bool in_narrows = narrows(in_layout, keep);
+    if (!out_narrows && !in_narrows) return t;
+    CGSR_CHECK(op.groups == 1, "select_channels: grouped convolution " + op.name + " cannot be narrowed");
+    if (out_narrows) {
+      const auto rows = selected_positions(out_layout, keep);
+      t.weight = take(t.weight, 0, rows);
+      if (t.bias.defined()) t.bias = take(t.bias, 0, rows);
+    }
+    if (in_narrows) t.weight = take(t.weight, 1, selected_positions(in_layout, keep));
+  } else if (op.kind == graph::OpKind::ChannelAffine && out_narrows) {
+    const auto positions = selected_positions(out_layout, keep);
+    if (t.scale.defined()) t.scale = take(t.scale, 0, positions);
+    if (t.shift.defined()) t.shift = take(t.shift, 0, positions);
+  }
+  return t;
+}
+
+graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep) {
+  check_selection(graph, keep, "channel selection");
+  torch::NoGradGuard no_grad;
+  graph::Graph out = graph;
+  for (auto& op : out.ops) {
+    if (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine) continue;
+    auto t = select_op_tensors(graph, op, keep);
+    op.weight = t.weight;
+    op.bias = t.bias;
+    op.scale = t.scale;
+    op.shift = t.shift;
+  }
+  for (auto& v : out.values) v.layout = selected_layout(v.layout, keep);
+  return out;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,98 @@
+#include "pruning/hybrid_model.h"
+
+#include <torch/torch.h>
+
+#include <set>
+
+#include "core/error.h"
+#include "core/tensor_checks.h"
+
+namespace cgsr {
+
+namespace {
+constexpr const char* kKey = "dynamic_pruning";
+constexpr int kFormat = 1;
+const std::string kPrefix = std::string(kExtraTensorPrefix) + "dpc.";
+}  // namespace
+
+bool is_hybrid_model(const Provenance& provenance) {
+  return provenance.extra.is_object() && provenance.extra.contains(kKey);
+}
+
+void save_hybrid_model(const std::filesystem::path& path, const HybridModel& model) {
+  ModelFileContents contents;
+  contents.spec = model.network->spec();
+  contents.provenance = model.provenance;
+  const auto& options = model.samplers->options();
+  contents.provenance.extra[kKey] = {{"format", kFormat},
+                                     {"sampler", {{"channels", options.channels},
+                                                  {"grid", options.grid},
+                                                  {"width", options.width}}},
+                                     {"patterns", model.samplers->patterns()},
+                                     {"pool", to_json(model.pool)}};
+  for (const auto& p : model.network->named_parameters(/*recurse=*/true)) contents.tensors.emplace_back(p.key(), p.value());
+  for (const auto& p : model.samplers->named_parameters(/*recurse=*/true))
+    contents.tensors.emplace_back(kPrefix + p.key(), p.value());
+  write_model_file(path, contents);
+}
+
+HybridModel load_hybrid_model(const std::filesystem::path& path) {
+  const std::string where = path.string();
+  Model base = load_model(path);
+  if (!is_hybrid_model(base.provenance))
+    throw Error(where, "not a hybrid-pruned model (no dynamic pruning components; made by cgsr prune?)");
+  const ModelFileContents contents = read_model_file(path);
+  HybridModel model;
+  model.network = base.network;
+  model.network->eval();
+  model.provenance = base.provenance;
+  const auto& j = base.provenance.extra[kKey];
+  SamplerOptions options;
+  std::vector<int> patterns;
+  try {
+    if (j.at("format").get<int>() != kFormat)
+      throw Error(where, "dynamic pruning data format " + j.at("format").dump() + " is not supported");
+    options.channels = j.at("sampler").at("channels").get<std::vector<std::string>>();
+    options.grid = j.at("sampler").at("grid").get<int>();
+    options.width = j.at("sampler").at("width").get<int>();
+    patterns = j.at("patterns").get<std::vector<int>>();
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(where, std::string("malformed dynamic pruning data: ") + e.what());
+  }
+  try {
+    options.render_channels();
+  } catch (const Error& e) {
+    throw e.within(where);
+  }
+  if (options.grid < 2 || options.width < 1) throw Error(where, "invalid dynamic sampler settings");
+  const auto units = find_units(model.network->describe(false));
+  model.pool = pool_from_json(j.at("pool"), units, where);
+  if (patterns.size() != model.pool.units.size())
+    throw Error(where, "dynamic samplers for " + std::to_string(patterns.size()) + " units, the pool has " +
+                           std::to_string(model.pool.units.size()));
+  for (size_t u = 0; u < patterns.size(); ++u)
+    if (patterns[u] != static_cast<int>(model.pool.units[u].patterns.size()))
+      throw Error(where, "the sampler of unit " + model.pool.units[u].unit.name + " scores " +
+                             std::to_string(patterns[u]) + " patterns, the pool holds " +
+                             std::to_string(model.pool.units[u].patterns.size()));
+  model.samplers = DynamicSamplers(options, patterns);
+  auto params = model.samplers->named_parameters(/*recurse=*/true);
+  std::set<std::string> seen;
+  torch::NoGradGuard no_grad;
+  for (const auto& [name, value] : contents.tensors) {
+    if (name.rfind(kPrefix, 0) != 0) continue;
+    const std::string key = name.substr(kPrefix.size());
+    torch::Tensor* target = params.find(key);
+    if (!target || target->sizes() != value.sizes())
+      throw Error(where, "dynamic sampler tensor " + name + " " + shape_string(value) + " does not fit the samplers");
+    require_finite(value, where + ": " + name);
+    target->copy_(value);
+    seen.insert(key);
+  }
+  for (const auto& p : params)
+    if (!seen.count(p.key())) throw Error(where, "missing dynamic sampler tensor " + kPrefix + p.key());
+  model.samplers->eval();
+  return model;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,126 @@
+#include "pruning/hybrid_upscaler.h"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "core/text.h"
+
+namespace cgsr {
+
+namespace {
+// Rows of `info` (stacked in `available` order) holding `wanted`, in `wanted` order.
+torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
+                            const std::vector<RenderChannel>& wanted) {
+  std::vector<torch::Tensor> parts;
+  for (auto c : wanted) {
+    int64_t offset = 0;
+    bool found = false;
+    for (auto a : available) {
+      if (a == c) {
+        found = true;
+        break;
+      }
+      offset += channel_width(a);
+    }
+    if (!found || !info.defined())
+      throw Error("batch", "the dynamic samplers need rendering channel '" + channel_name(c) +
+                               "' but the batch has only " +
+                               (available.empty() ? std::string("none") : join(channel_names(available))));
+    parts.push_back(info.slice(1, offset, offset + channel_width(c)));
+  }
+  return torch::cat(parts, 1);
+}
+}  // namespace
+
+HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std::move(name)), model_(std::move(model)) {
+  model_.network->eval();
+  model_.samplers->eval();
+  sampler_channels_ = model_.samplers->options().render_channels();
+  channels_ = model_.network->input_channels();
+  for (auto c : sampler_channels_)
+    if (std::find(channels_.begin(), channels_.end(), c) == channels_.end()) channels_.push_back(c);
+  std::sort(channels_.begin(), channels_.end());
+  executor_ = std::make_unique<PatternExecutor>(*model_.network, model_.pool);
+}
+
+torch::Tensor HybridUpscaler::sampler_info(const Batch& batch) const {
+  return pick_channels(batch.lr_info, batch.channels, sampler_channels_);
+}
+
+void HybridUpscaler::previous_frame(const Batch& previous) {
+  previous_info_ = sampler_info(previous);
+  previous_frame_ = previous.frames.empty() ? -1 : previous.frames.front();
+}
+
+std::vector<int> HybridUpscaler::choose(const Batch& batch) {
+  if (batch.lr_color.size(0) != 1)
+    throw Error("hybrid-pruned model", "chooses patterns per frame: give one frame at a time, got a batch of " +
+                                           std::to_string(batch.lr_color.size(0)));
+  torch::NoGradGuard no_grad;
+  const auto info = sampler_info(batch);
+  const int frame = batch.frames.empty() ? -1 : batch.frames.front();
+  torch::Tensor previous;
+  bool has_previous = false;
+  if (previous_info_.defined() && frame >= 0 && previous_frame_ == frame - 1) {
+    previous = previous_info_;
+    has_previous = true;
+  } else if (last_info_.defined() && frame >= 0 && last_frame_ == frame - 1) {
+    previous = last_info_;
+    has_previous = true;
+  }
+  if (previous.defined() && previous.sizes() != info.sizes()) {
+    previous = torch::Tensor();
+    has_previous = false;
+  }
+  const auto input = sampler_input(info, previous, sampler_channels_, model_.samplers->options().grid);
+  const auto choice = model_.samplers->choose(input).front();
+  previous_info_ = torch::Tensor();
+  previous_frame_ = -1;
+  last_info_ = info;
+  last_frame_ = frame;
+  details_ = {{"previous_frame", has_previous}};
+  return choice;
+}
+
+torch::Tensor HybridUpscaler::upscale(const Batch& batch) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto choice = choose(batch);
+  const double choose_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto out = executor_->run(batch.lr_color, model_.network->info_input(batch), choice);
+  auto patterns = nlohmann::ordered_json::object();
+  for (size_t u = 0; u < choice.size(); ++u) patterns[model_.pool.units[u].unit.name] = choice[u];
+  details_["patterns"] = patterns;
+  details_["choose_ms"] = choose_ms;
+  return out;
+}
+
+std::optional<Complexity> HybridUpscaler::cost(int64_t lr_width, int64_t lr_height) const {
+  // MACs: what one frame executes. Every pattern of a unit keeps the same channel counts, so
+  // any choice costs the same; count the first. Params: what the model holds, i.e. the static
+  // network (the union of its patterns). The samplers add to both (their MACs do not depend on
+  // the frame size).
+  const graph::Graph g = model_.network->describe(false);
+  const std::vector<int> first(model_.pool.units.size(), 0);
+  Complexity c = complexity(select_channels(g, model_.pool.selection(first)), lr_width, lr_height);
+  c.params = complexity(g, lr_width, lr_height).params;
+  LayerCost samplers;
+  samplers.name = "dynamic_samplers";
+  samplers.kind = "dynamic_sampler";
+  samplers.params = model_.samplers->parameter_count();
+  samplers.macs = model_.samplers->macs();
+  c.layers.push_back(samplers);
+  c.params += samplers.params;
+  c.macs += samplers.macs;
+  return c;
+}
+
+std::unique_ptr<Upscaler> make_hybrid_upscaler(const std::filesystem::path& path, const std::string& name) {
+  HybridModel model = load_hybrid_model(path);
+  std::string display = name;
+  if (display.empty()) display = model.provenance.extra.value("name", path.stem().string());
+  return std::make_unique<HybridUpscaler>(display, std::move(model));
+}
+
+}  // namespace cgsr

@@ -1,0 +1,56 @@
+#pragma once
+// A hybrid-pruned model as an Upscaler: per frame, the dynamic samplers score each unit's
+// patterns from the current and previous frame's rendering information, the best pattern of
+// every unit is chosen, and the statically pruned network runs with those patterns as smaller
+// dense convolutions (pattern_executor.h). `cgsr eval` runs it through the same evaluation as
+// every other upscaler; frame_details() records the choice and the time spent choosing.
+//
+// The previous frame is the one given to previous_frame(), else the frame of the last
+// upscale() call when it is the frame just before (a renderer calling it frame after frame),
+// else none (its change is taken as zero).
+
+#include <chrono>
+#include <memory>
+
+#include "pruning/hybrid_model.h"
+#include "pruning/pattern_executor.h"
+#include "train/upscaler.h"
+
+namespace cgsr {
+
+class HybridUpscaler : public Upscaler {
+ public:
+  HybridUpscaler(std::string name, HybridModel model);
+
+  std::string name() const override { return name_; }
+  int scale() const override { return model_.network->spec().scale; }
+  std::vector<RenderChannel> channels() const override { return channels_; }
+  torch::Tensor upscale(const Batch& batch) override;
+  std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
+  bool uses_previous_frame() const override { return true; }
+  void previous_frame(const Batch& previous) override;
+  nlohmann::ordered_json frame_details() const override { return details_; }
+
+  // The patterns chosen for a frame (one index per unit) from its rendering information.
+  std::vector<int> choose(const Batch& batch);
+  const HybridModel& model() const { return model_; }
+
+ private:
+  torch::Tensor sampler_info(const Batch& batch) const;
+
+  std::string name_;
+  HybridModel model_;
+  std::vector<RenderChannel> sampler_channels_, channels_;
+  std::unique_ptr<PatternExecutor> executor_;
+  torch::Tensor previous_info_;   // sampler channels of the previous frame
+  int previous_frame_ = -1;       // its frame index (-1: none)
+  int last_frame_ = -1;           // frame of the last upscale()
+  torch::Tensor last_info_;
+  nlohmann::ordered_json details_;
+};
+
+// Loads a hybrid-pruned model file as an upscaler; the display name defaults to the one recorded
+// in the file (provenance.extra.name) or the file's stem.
+std::unique_ptr<Upscaler> make_hybrid_upscaler(const std::filesystem::path& path, const std::string& name = "");
+
+}  // namespace cgsr

@@ -1,0 +1,49 @@
+#include "render_data/augment.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+
+namespace cgsr {
+
+Augmentation Augmentation::from_index(int index) {
+  CGSR_CHECK(index >= 0 && index < 8, "augmentation index must be in [0, 8)");
+  return {index >= 4, index % 4};
+}
+
+torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a) {
+  const int64_t h = image.dim() - 2, w = image.dim() - 1;
+  torch::Tensor t = a.flip ? image.flip({w}) : image;
+  // torch.rot90 with dims (H, W) turns the first axis towards the second: counter-clockwise as
+  // displayed (rows run down the screen).
+  if (a.rotations % 4) t = torch::rot90(t, a.rotations % 4, {h, w});
+  return t.contiguous();
+}
+
+torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderChannel>& channels, const Augmentation& a) {
+  torch::Tensor t = augment_image(info, a);
+  const int64_t cdim = info.dim() - 3;
+  int64_t offset = 0;
+  for (auto c : channels) {
+    const int width = channel_width(c);
+    if (c == RenderChannel::Normal || c == RenderChannel::Motion) {
+      // Components in image orientation: motion is (x right, y down); normals (x right, y up).
+      const bool y_up = c == RenderChannel::Normal;
+      auto x = t.select(cdim, offset).clone(), y = t.select(cdim, offset + 1).clone();
+      if (a.flip) x = -x;
+      for (int r = 0; r < a.rotations % 4; ++r) {
+        // Counter-clockwise: y-down (dx, dy) -> (dy, -dx); y-up (x, y) -> (-y, x).
+        auto nx = y_up ? -y : y, ny = y_up ? x : -x;
+        x = nx;
+        y = ny;
+      }
+      t.select(cdim, offset).copy_(x);
+      t.select(cdim, offset + 1).copy_(y);
+    }
+    offset += width;
+  }
+  CGSR_CHECK(offset == info.size(cdim), "info tensor width does not match its channel list");
+  return t;
+}
+
+}  // namespace cgsr

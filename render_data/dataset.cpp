@@ -1,0 +1,270 @@
+#include "render_data/dataset.h"
+
+#include <algorithm>
+#include <list>
+#include <mutex>
+#include <unordered_map>
+
+#include "core/error.h"
+#include "core/text.h"
+#include "render_data/derive_channels.h"
+#include "render_data/frame_files.h"
+#include "render_data/render_job.h"
+
+namespace cgsr {
+namespace fs = std::filesystem;
+
+config::Schema<DatasetOpenOptions> dataset_open_schema() {
+  config::Schema<DatasetOpenOptions> s;
+  s.field("layout", &DatasetOpenOptions::layout, "dataset layout (auto, cgsr, cgsr-release, glob)");
+  auto names_ok = [](const std::vector<std::string>& v) {
+    const auto valid = channel_names(all_render_channels());
+    for (const auto& n : v)
+      if (std::find(valid.begin(), valid.end(), n) == valid.end()) return false;
+    return true;
+  };
+  s.field("channels", &DatasetOpenOptions::channels, "rendering channels to load (empty: all)")
+      .check(names_ok, "unknown channel; valid: " + join(channel_names(all_render_channels())));
+  s.field("derive", &DatasetOpenOptions::derive, "channels to derive from depth when missing (edge, normal, normal_angle)")
+      .check(names_ok, "unknown channel; valid: " + join(channel_names(all_render_channels())));
+  s.field("clean_grid_lines", &DatasetOpenOptions::clean_grid_lines, "remove tile-grid lines from CGSR-release edges");
+  s.field("near", &DatasetOpenOptions::near_plane, "near plane for layouts without one (0: default)").at_least(0);
+  s.field("far", &DatasetOpenOptions::far_plane, "far plane for layouts without one (0: default)").at_least(0);
+  s.field("vfov", &DatasetOpenOptions::vfov, "vertical field of view for derived normals (0: default)").range(0, 179);
+  s.field("cache_gb", &DatasetOpenOptions::cache_gb, "frame cache budget, GiB").range(0, 1024);
+  s.section("edges", &DatasetOpenOptions::edges, edge_settings_schema(), "thresholds for derived edges");
+  return s;
+}
+
+void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
+  const auto derive = parse_channels(options.derive);
+  auto stored = [&](RenderChannel c) { return std::find(info.stored.begin(), info.stored.end(), c) != info.stored.end(); };
+  std::vector<RenderChannel> requested;
+  if (options.channels.empty()) {
+    requested = info.stored;
+    for (auto c : derive)
+      if (!stored(c)) requested.push_back(c);
+    std::sort(requested.begin(), requested.end());
+  } else {
+    requested = parse_channels(options.channels);
+  }
+  info.derived.clear();
+  for (auto c : requested) {
+    if (stored(c)) continue;
+    const bool asked = std::find(derive.begin(), derive.end(), c) != derive.end();
+    if (!asked || !derivable(c))
+      throw Error(info.root.string(), "the dataset has no '" + channel_name(c) + "' channel (stored: " +
+                                          (info.stored.empty() ? std::string("none") : join(channel_names(info.stored))) + ")" +
+                                          (derivable(c) ? "; list it under derive to compute it from depth" : ""));
+    info.derived.push_back(c);
+  }
+  if (!info.derived.empty() && !stored(RenderChannel::Depth))
+    throw Error(info.root.string(), "cannot derive " + join(channel_names(info.derived)) + ": the dataset has no depth");
+  info.channels = requested;
+  if (info.stored_at.empty()) info.stored_at.assign(info.resolutions.size(), info.stored);
+  info.channels_at.clear();
+  for (const auto& here : info.stored_at) {
+    auto has = [&](RenderChannel c) { return std::find(here.begin(), here.end(), c) != here.end(); };
+    std::vector<RenderChannel> out;
+    for (auto c : requested) {
+      const bool derived = std::find(info.derived.begin(), info.derived.end(), c) != info.derived.end();
+      if (has(c) || (derived && has(RenderChannel::Depth))) out.push_back(c);
+    }
+    info.channels_at.push_back(out);
+  }
+}
+
+const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t resolution) {
+  return info.channels_at.at(resolution);
+}
+
+// ---- our own format -----------------------------------------------------------------------------
+
+namespace {
+class CgsrDataset : public FrameSource {
+ public:
+  CgsrDataset(const fs::path& root, const DatasetOpenOptions&) : root_(root), manifest_(read_manifest(root)) {
+    if (!manifest_.complete)
+      throw Error((root / "manifest.yaml").string(),
+                  "the render is incomplete (complete: false); rerun the same `cgsr render` command to finish it");
+    info_.name = manifest_.name;
+    info_.layout = "cgsr";
+    info_.root = root;
+    info_.frames = manifest_.frames;
+    info_.resolutions = manifest_.resolutions;
+    info_.near_plane = manifest_.near_plane;
+    info_.far_plane = manifest_.far_plane;
+    info_.vfov = manifest_.vfov;
+    info_.stored = all_render_channels();
+    info_.split = manifest_.split;
+  }
+  const DatasetInfo& info() const override { return info_; }
+  Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {
+    return read_dataset_frame(root_, manifest_, frame, res, channels);
+  }
+
+ private:
+  fs::path root_;
+  DatasetManifest manifest_;
+  DatasetInfo info_;
+};
+}  // namespace
+
+std::unique_ptr<FrameSource> open_cgsr_dataset(const fs::path& root, const DatasetOpenOptions& options) {
+  return std::make_unique<CgsrDataset>(root, options);
+}
+
+// ---- registry -------------------------------------------------------------------------------------
+
+Registry<DatasetLoader>& dataset_loaders() {
+  static Registry<DatasetLoader> registry("dataset layout");
+  return registry;
+}
+
+void register_builtin_dataset_loaders() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    auto& r = dataset_loaders();
+    r.add("cgsr", {[](const fs::path& p) { return fs::is_directory(p) && has_manifest(p); }, open_cgsr_dataset},
+          "cgsr's own format (manifest.yaml), written by `cgsr render`");
+    r.add("cgsr-release", {looks_like_cgsr_release, open_cgsr_release},
+          "the CGSR data release: <trace>/<width>/frame###.sim.ppm + feature###.bmp");
+    r.add("glob", {looks_like_glob_layout, open_glob_layout},
+          "per-channel glob patterns in a YAML file (layout: glob)");
+  });
+}
+
+// ---- Dataset ------------------------------------------------------------------------------------
+
+struct Dataset::Impl {
+  std::unique_ptr<FrameSource> source;
+  DatasetInfo info;
+  DatasetOpenOptions options;
+  std::vector<RenderChannel> load_channels;  // what the source reads (adds depth for derivation)
+  size_t budget = 0;
+
+  mutable std::mutex mutex;
+  using Key = int64_t;
+  mutable std::list<Key> lru;  // most recent first
+  struct Entry {
+    std::shared_ptr<const Frame> frame;
+    std::list<Key>::iterator position;
+  };
+  mutable std::unordered_map<Key, Entry> cache;
+  mutable size_t bytes = 0;
+
+  Frame load(int index, size_t res) const {
+    if (index < 0 || index >= info.frames)
+      throw Error(info.root.string(), "frame " + std::to_string(index) + " out of range (" + std::to_string(info.frames) + " frames)");
+    if (res >= info.resolutions.size()) throw Error(info.root.string(), "resolution index out of range");
+    std::vector<RenderChannel> here;  // what this resolution's files can give
+    for (auto c : load_channels)
+      if (std::find(info.stored_at[res].begin(), info.stored_at[res].end(), c) != info.stored_at[res].end())
+        here.push_back(c);
+    Frame f = source->load(index, res, here);
+    if (!info.derived.empty() && f.depth.defined()) {
+      try {
+        derive_channels(f, info.derived, info.vfov, options.edges);
+      } catch (const Error& e) {
+        throw Error(info.root.string(), "frame " + std::to_string(index) + ": " + e.message(), e.kind());
+      }
+      if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Depth) == info.channels.end())
+        f.depth = torch::Tensor();
+    }
+    return f;
+  }
+};
+
+Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
+  register_builtin_dataset_loaders();
+  if (!fs::exists(path)) throw Error(path.string(), "no such dataset directory or file");
+  auto& loaders = dataset_loaders();
+  std::string layout = options.layout;
+  if (layout == "auto") {
+    layout.clear();
+    for (const auto& name : loaders.names())
+      if (loaders.get(name).detect(path)) {
+        layout = name;
+        break;
+      }
+    if (layout.empty())
+      throw Error(path.string(), "not a dataset in any known layout (" + join(loaders.names()) +
+                                     "): expected manifest.yaml, a YAML file with layout: glob, or "
+                                     "<width>/frame###.sim.ppm folders");
+  }
+  Dataset d;
+  d.impl_ = std::make_shared<Impl>();
+  Impl& impl = *d.impl_;
+  impl.source = loaders.get(layout).open(path, options);
+  impl.info = impl.source->info();
+  impl.options = options;
+  resolve_channels(impl.info, options);
+  for (auto c : impl.info.channels)
+    if (std::find(impl.info.derived.begin(), impl.info.derived.end(), c) == impl.info.derived.end())
+      impl.load_channels.push_back(c);
+  if (!impl.info.derived.empty() &&
+      std::find(impl.load_channels.begin(), impl.load_channels.end(), RenderChannel::Depth) == impl.load_channels.end())
+    impl.load_channels.push_back(RenderChannel::Depth);
+  std::sort(impl.load_channels.begin(), impl.load_channels.end());
+  impl.budget = static_cast<size_t>(options.cache_gb * 1024.0 * 1024.0 * 1024.0);
+  return d;
+}
+
+const DatasetInfo& Dataset::info() const { return impl_->info; }
+int Dataset::frame_count() const { return impl_->info.frames; }
+const std::vector<Resolution>& Dataset::resolutions() const { return impl_->info.resolutions; }
+
+size_t Dataset::resolution_index(const Resolution& r) const {
+  const auto& rs = impl_->info.resolutions;
+  for (size_t i = 0; i < rs.size(); ++i)
+    if (rs[i] == r) return i;
+  std::vector<std::string> names;
+  for (const auto& x : rs) names.push_back(x.name());
+  throw Error(impl_->info.root.string(), "has no resolution " + r.name() + " (has: " + join(names) + ")");
+}
+
+std::vector<int> Dataset::frames(Split split) const {
+  if (split != Split::All) return impl_->info.split.of(split);
+  std::vector<int> all(impl_->info.frames);
+  for (int i = 0; i < impl_->info.frames; ++i) all[i] = i;
+  return all;
+}
+
+Frame Dataset::load(int index, size_t resolution) const { return impl_->load(index, resolution); }
+
+std::shared_ptr<const Frame> Dataset::frame(int index, size_t resolution) const {
+  Impl& impl = *impl_;
+  const Impl::Key key = static_cast<int64_t>(index) * 64 + static_cast<int64_t>(resolution);
+  {
+    std::lock_guard<std::mutex> lock(impl.mutex);
+    const auto it = impl.cache.find(key);
+    if (it != impl.cache.end()) {
+      impl.lru.splice(impl.lru.begin(), impl.lru, it->second.position);
+      return it->second.frame;
+    }
+  }
+  // Decode outside the lock; a concurrent load of the same frame keeps the first result.
+  auto frame = std::make_shared<const Frame>(impl.load(index, resolution));
+  std::lock_guard<std::mutex> lock(impl.mutex);
+  const auto it = impl.cache.find(key);
+  if (it != impl.cache.end()) return it->second.frame;
+  const size_t size = frame->bytes();
+  if (size > impl.budget) return frame;  // larger than the whole cache: not kept
+  while (impl.bytes + size > impl.budget && !impl.lru.empty()) {
+    const Impl::Key victim = impl.lru.back();
+    impl.lru.pop_back();
+    impl.bytes -= impl.cache.at(victim).frame->bytes();
+    impl.cache.erase(victim);
+  }
+  impl.lru.push_front(key);
+  impl.cache.emplace(key, Impl::Entry{frame, impl.lru.begin()});
+  impl.bytes += size;
+  return frame;
+}
+
+size_t Dataset::cached_bytes() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->bytes;
+}
+
+}  // namespace cgsr

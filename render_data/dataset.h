@@ -1,0 +1,113 @@
+#pragma once
+// Datasets of aligned multi-resolution frames, whatever their layout on disk:
+//
+//   Dataset data = Dataset::open("runs/render-default");       // layout detected
+//   const Frame& hr = *data.frame(12, data.resolution_index({640, 480}));
+//   data.frames(Split::Train)                                  // frame indices of a split
+//
+// Layouts (the "dataset loader" registry, one entry per layout):
+//   cgsr          our own format, written by `cgsr render` (a directory with manifest.yaml)
+//   cgsr-release  the CGSR data release: <trace>/<width>/frame###.sim.ppm + feature###.bmp
+//                 (R edge mask 0/255, G normalized depth, B normal angle)
+//   glob          any capture described by a YAML file of per-channel glob patterns (glob_layout.h)
+// Every loader produces the same in-memory Frame (frame.h). Channels the data lacks are derived
+// on request (derive_channels.h) and listed in info().derived. Frames are cached up to a byte
+// budget (least recently used frames are dropped); the cache is thread-safe.
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/registry.h"
+#include "render_data/dataset_manifest.h"
+#include "render_data/edges.h"
+#include "render_data/frame.h"
+
+namespace cgsr {
+
+struct DatasetOpenOptions {
+  std::string layout = "auto";           // auto, or a registered layout name
+  std::vector<std::string> channels;     // channels to load; empty: every stored + derived channel
+  std::vector<std::string> derive;       // channels to derive when the data lacks them
+  bool clean_grid_lines = false;         // cgsr-release: remove the simulator's tile-grid lines
+  double near_plane = 0, far_plane = 0;  // layouts without planes (cgsr-release, glob): 0 = layout default
+  double vfov = 0;                       // vertical FOV for derived normals; 0 = layout default
+  double cache_gb = 3.0;                 // frame cache budget, GiB
+  EdgeSettings edges;                    // thresholds for derived edges
+};
+
+config::Schema<DatasetOpenOptions> dataset_open_schema();
+
+struct DatasetInfo {
+  std::string name, layout;
+  std::filesystem::path root;
+  int frames = 0;
+  std::vector<Resolution> resolutions;  // ascending
+  double near_plane = 0.05, far_plane = 500, vfov = 60;
+  std::vector<RenderChannel> stored;    // read from files (at one resolution at least)
+  std::vector<RenderChannel> derived;   // computed on load
+  std::vector<RenderChannel> channels;  // what frames carry: loaded stored + derived, fixed order
+  // Per resolution: what the files hold (loaders fill it; empty = `stored` everywhere), and what
+  // its frames carry after loading and derivation (a capture may have depth only at LR).
+  std::vector<std::vector<RenderChannel>> stored_at, channels_at;
+  FrameSplit split;
+  std::vector<std::string> notes;       // e.g. "tile-grid lines removed from edges"
+};
+
+// What a layout implements: metadata, and one frame at one resolution with the given channels
+// (a subset of info().stored). Errors name the file and frame.
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual const DatasetInfo& info() const = 0;
+  virtual Frame load(int frame, size_t resolution, const std::vector<RenderChannel>& channels) const = 0;
+};
+
+struct DatasetLoader {
+  std::function<bool(const std::filesystem::path&)> detect;  // does `path` look like this layout?
+  std::function<std::unique_ptr<FrameSource>(const std::filesystem::path&, const DatasetOpenOptions&)> open;
+};
+
+Registry<DatasetLoader>& dataset_loaders();
+void register_builtin_dataset_loaders();  // cgsr, cgsr-release, glob; calling again is harmless
+
+class Dataset {
+ public:
+  // `path`: a dataset directory, or a glob-layout YAML file. Throws cgsr::Error naming the path
+  // when no layout matches, listing the layouts.
+  static Dataset open(const std::filesystem::path& path, const DatasetOpenOptions& options = {});
+
+  const DatasetInfo& info() const;
+  int frame_count() const;
+  const std::vector<Resolution>& resolutions() const;
+  size_t resolution_index(const Resolution& r) const;  // cgsr::Error listing the resolutions
+  std::vector<int> frames(Split split) const;           // Split::All: 0 .. N-1
+
+  // Cached; safe to call from several threads.
+  std::shared_ptr<const Frame> frame(int index, size_t resolution) const;
+  // Bypasses the cache (data check, benchmarks).
+  Frame load(int index, size_t resolution) const;
+
+  size_t cached_bytes() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+// Loader entry points (dataset.cpp registers them).
+std::unique_ptr<FrameSource> open_cgsr_dataset(const std::filesystem::path& root, const DatasetOpenOptions& options);
+std::unique_ptr<FrameSource> open_cgsr_release(const std::filesystem::path& root, const DatasetOpenOptions& options);
+bool looks_like_cgsr_release(const std::filesystem::path& root);
+std::unique_ptr<FrameSource> open_glob_layout(const std::filesystem::path& path, const DatasetOpenOptions& options);
+bool looks_like_glob_layout(const std::filesystem::path& path);
+
+// The channels that `options.channels` names (empty: all stored ones plus `derive`), checked
+// against what the data has and what can be derived; fills derived, channels and channels_at.
+void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options);
+const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t resolution);
+
+}  // namespace cgsr

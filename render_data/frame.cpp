@@ -1,0 +1,78 @@
+#include "render_data/frame.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+
+namespace cgsr {
+
+bool Frame::has(RenderChannel c) const {
+  switch (c) {
+    case RenderChannel::Depth: return depth.defined();
+    case RenderChannel::Normal: return normal.defined();
+    case RenderChannel::NormalAngle: return normal_angle.defined();
+    case RenderChannel::Edge: return edge.defined();
+    case RenderChannel::Motion: return motion.defined();
+  }
+  return false;
+}
+
+std::vector<RenderChannel> Frame::channels() const {
+  std::vector<RenderChannel> out;
+  for (auto c : all_render_channels())
+    if (has(c)) out.push_back(c);
+  return out;
+}
+
+torch::Tensor Frame::color_float() const { return color.to(torch::kFloat32).div_(255.0f); }
+
+torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, double near_plane, double far_plane) const {
+  std::vector<torch::Tensor> parts;
+  for (auto c : channels) {
+    if (!has(c)) throw Error("frame", "has no '" + channel_name(c) + "' channel");
+    switch (c) {
+      case RenderChannel::Depth: parts.push_back(normalize_depth(depth, near_plane, far_plane)); break;
+      case RenderChannel::Normal: parts.push_back(normal.to(torch::kFloat32)); break;
+      case RenderChannel::NormalAngle: parts.push_back(normal_angle.to(torch::kFloat32)); break;
+      case RenderChannel::Edge: parts.push_back(edge.to(torch::kFloat32)); break;
+      case RenderChannel::Motion: parts.push_back(motion.to(torch::kFloat32)); break;
+    }
+  }
+  if (parts.empty()) return torch::zeros({0, height, width}, torch::kFloat32);
+  return torch::cat(parts, 0);
+}
+
+size_t Frame::bytes() const {
+  size_t n = 0;
+  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion})
+    if (t->defined()) n += t->numel() * t->element_size();
+  return n;
+}
+
+Frame crop(const Frame& f, int x, int y, int w, int h) {
+  CGSR_CHECK(x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= f.width && y + h <= f.height, "crop outside the frame");
+  Frame out;
+  out.width = w;
+  out.height = h;
+  const Frame* src = &f;
+  for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
+                           std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},
+                           std::pair{&out.edge, &src->edge}, std::pair{&out.motion, &src->motion}})
+    if (from->defined()) *dst = from->slice(1, y, y + h).slice(2, x, x + w);
+  return out;
+}
+
+Frame frame_from_gbuffer(const GBuffer& g) {
+  Frame f;
+  f.width = g.width;
+  f.height = g.height;
+  f.color = (g.color.clamp(0, 1) * 255.0f).round().to(torch::kUInt8);
+  f.depth = g.depth.clone();
+  f.normal = g.normal.to(torch::kFloat16);
+  f.normal_angle = g.normal_angle.to(torch::kFloat16);
+  f.edge = g.edge.to(torch::kUInt8);
+  f.motion = g.motion.clone();
+  return f;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,42 @@
+#pragma once
+// One frame at one resolution in memory: the single representation every loader produces and
+// the samplers consume. Kept compact so long sequences fit in memory: colour and edges as bytes,
+// normals and normal angles as half floats; depth and motion stay float32 (depth spans 1e-3 to
+// 1e6 metres and infinity; motion needs sub-pixel precision over hundreds of pixels).
+// A channel that the data does not have (and was not derived) is an undefined tensor.
+
+#include <torch/types.h>
+
+#include <vector>
+
+#include "render_data/gbuffer.h"
+#include "render_data/render_channels.h"
+
+namespace cgsr {
+
+struct Frame {
+  int width = 0, height = 0;
+  torch::Tensor color;         // uint8 [3,H,W], sRGB-encoded
+  torch::Tensor depth;         // float32 [1,H,W], linear view depth; +inf where there is no geometry
+  torch::Tensor normal;        // float16 [3,H,W], view-space unit normal; 0 where there is no geometry
+  torch::Tensor normal_angle;  // float16 [1,H,W] in [0,1]
+  torch::Tensor edge;          // uint8 [1,H,W], 0 or 1
+  torch::Tensor motion;        // float32 [2,H,W], pixels (render_channels.h)
+
+  bool has(RenderChannel channel) const;
+  std::vector<RenderChannel> channels() const;  // present channels, in the fixed order
+  // float32 [3,H,W] in [0,1].
+  torch::Tensor color_float() const;
+  // float32 [total_width(channels),H,W] in the contract's form (depth through normalize_depth).
+  // Throws cgsr::Error when a requested channel is missing.
+  torch::Tensor info(const std::vector<RenderChannel>& channels, double near_plane, double far_plane) const;
+  size_t bytes() const;  // memory held by the tensors
+};
+
+// A window of `f` (views of its tensors, no copy): columns x .. x + w - 1, rows y .. y + h - 1.
+Frame crop(const Frame& f, int x, int y, int w, int h);
+
+// Compacts a rendered G-buffer (colour quantized to 8 bits as it would be stored).
+Frame frame_from_gbuffer(const GBuffer& g);
+
+}  // namespace cgsr

@@ -1,0 +1,256 @@
+#include "render_data/glob_layout.h"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cctype>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "render_data/dataset.h"
+#include "render_data/frame_files.h"
+
+namespace cgsr {
+namespace fs = std::filesystem;
+
+config::Schema<GlobLayoutOptions> glob_layout_schema() {
+  config::Schema<GlobResolution> r;
+  r.field("size", &GlobResolution::size, "WxH of this resolution").required();
+  r.field("color", &GlobResolution::color, "colour frames (required)").required();
+  r.field("depth", &GlobResolution::depth, "depth frames");
+  r.field("normal", &GlobResolution::normal, "normal frames, (n + 1) / 2");
+  r.field("normal_angle", &GlobResolution::normal_angle, "normal angle frames, grey");
+  r.field("edge", &GlobResolution::edge, "edge masks, grey 0/1");
+  r.field("motion", &GlobResolution::motion, "motion vectors (dx, dy) in pixels");
+  config::Schema<GlobLayoutOptions> s;
+  s.field("layout", &GlobLayoutOptions::layout, "must be glob").one_of({"glob"}).required();
+  s.field("name", &GlobLayoutOptions::name, "dataset name");
+  s.field("near", &GlobLayoutOptions::near_plane, "near plane of the depth").range(1e-9, 1e12);
+  s.field("far", &GlobLayoutOptions::far_plane, "far plane of the depth").range(1e-9, 1e30);
+  s.field("vfov", &GlobLayoutOptions::vfov, "vertical field of view, degrees").range(1, 179);
+  s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored").one_of({"normalized", "linear"});
+  s.list("resolutions", &GlobLayoutOptions::resolutions, r, "one entry per resolution");
+  s.validate([](const GlobLayoutOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (o.resolutions.empty()) at.child("resolutions").fail(node, "needs at least one resolution");
+    if (!(o.far_plane > o.near_plane)) at.child("far").fail(node, "far must be larger than near");
+  });
+  return s;
+}
+
+bool natural_less(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      // Compare by value: strip leading zeros, then length, then digits.
+      size_t is = i, js = j;
+      while (is + 1 < ie && a[is] == '0') ++is;
+      while (js + 1 < je && b[js] == '0') ++js;
+      if (ie - is != je - js) return ie - is < je - js;
+      const int c = a.compare(is, ie - is, b, js, je - js);
+      if (c != 0) return c < 0;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+namespace {
+bool wildcard_match(const char* p, const char* s) {
+  // Iterative matcher with backtracking on the last '*'.
+  const char *star = nullptr, *resume = nullptr;
+  while (*s) {
+    if (*p == '?' || *p == *s) {
+      ++p, ++s;
+    } else if (*p == '*') {
+      star = p++;
+      resume = s;
+    } else if (star) {
+      p = star + 1;
+      s = ++resume;
+    } else {
+      return false;
+    }
+  }
+  while (*p == '*') ++p;
+  return *p == 0;
+}
+}  // namespace
+
+std::vector<fs::path> glob_files(const fs::path& base, const std::string& pattern) {
+  const fs::path full = base / pattern;
+  const fs::path dir = full.parent_path();
+  const std::string name = full.filename().string();
+  if (dir.string().find_first_of("*?") != std::string::npos)
+    throw Error(pattern, "wildcards are only supported in the file name, not in folders");
+  if (!fs::is_directory(dir)) throw Error(pattern, "no such folder " + dir.string());
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && wildcard_match(name.c_str(), e.path().filename().string().c_str())) out.push_back(e.path());
+  std::sort(out.begin(), out.end(),
+            [](const fs::path& a, const fs::path& b) { return natural_less(a.filename().string(), b.filename().string()); });
+  return out;
+}
+
+namespace {
+
+struct ResolutionFiles {
+  Resolution size;
+  std::vector<std::vector<fs::path>> files;  // per RenderChannel (empty: absent)
+  std::vector<fs::path> color;
+};
+
+class GlobDataset : public FrameSource {
+ public:
+  GlobDataset(const fs::path& yaml, const DatasetOpenOptions& options) {
+    const auto doc = config::Document::load_file(yaml);
+    const auto o = config::parse_document(doc, glob_layout_schema());
+    linear_depth_ = o.depth_encoding == "linear";
+    const fs::path base = yaml.parent_path();
+    info_.name = o.name.empty() ? yaml.stem().string() : o.name;
+    info_.layout = "glob";
+    info_.root = yaml;
+    info_.near_plane = options.near_plane > 0 ? options.near_plane : o.near_plane;
+    info_.far_plane = options.far_plane > 0 ? options.far_plane : o.far_plane;
+    info_.vfov = options.vfov > 0 ? options.vfov : o.vfov;
+    size_t count = 0;
+    std::string count_from;
+    std::vector<bool> present(all_render_channels().size(), false);
+    std::vector<std::vector<RenderChannel>> stored_at;
+    for (const auto& r : o.resolutions) {
+      ResolutionFiles rf;
+      rf.size = parse_resolution(r.size, yaml.string() + ": size");
+      rf.files.resize(all_render_channels().size());
+      auto collect = [&](const std::string& pattern, std::vector<fs::path>& out, const std::string& what) {
+        if (pattern.empty()) return false;
+        out = glob_files(base, pattern);
+        if (out.empty()) throw Error(yaml.string(), r.size + " " + what + ": pattern '" + pattern + "' matches no file");
+        if (count == 0) count = out.size(), count_from = r.size + " " + what;
+        if (out.size() != count)
+          throw Error(yaml.string(), r.size + " " + what + ": pattern '" + pattern + "' matches " + std::to_string(out.size()) +
+                                         " files but " + count_from + " matches " + std::to_string(count));
+        return true;
+      };
+      collect(r.color, rf.color, "color");
+      const std::string* patterns[] = {&r.depth, &r.normal, &r.normal_angle, &r.edge, &r.motion};
+      std::vector<RenderChannel> here;
+      for (size_t c = 0; c < all_render_channels().size(); ++c)
+        if (collect(*patterns[c], rf.files[c], channel_name(all_render_channels()[c]))) {
+          present[c] = true;
+          here.push_back(all_render_channels()[c]);
+        }
+      stored_at.push_back(here);
+      info_.resolutions.push_back(rf.size);
+      res_.push_back(std::move(rf));
+    }
+    std::vector<size_t> order(res_.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return res_[a].size.width < res_[b].size.width; });
+    std::vector<ResolutionFiles> sorted;
+    info_.resolutions.clear();
+    for (size_t i : order) {
+      info_.resolutions.push_back(res_[i].size);
+      info_.stored_at.push_back(stored_at[i]);
+      sorted.push_back(std::move(res_[i]));
+    }
+    res_ = std::move(sorted);
+    const Resolution& lo = info_.resolutions.front();
+    for (const auto& r : info_.resolutions)
+      if (r.width % lo.width != 0 || r.height % lo.height != 0 || r.width / lo.width != r.height / lo.height)
+        throw Error(yaml.string(), "resolution " + r.name() + " is not an integer scale of " + lo.name());
+    for (size_t c = 0; c < present.size(); ++c)
+      if (present[c]) info_.stored.push_back(all_render_channels()[c]);
+    info_.frames = static_cast<int>(count);
+    info_.split = make_split(info_.frames);
+  }
+
+  const DatasetInfo& info() const override { return info_; }
+
+  Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {
+    const ResolutionFiles& rf = res_.at(res);
+    const Resolution& r = rf.size;
+    Frame f;
+    f.width = r.width;
+    f.height = r.height;
+    f.color = read_color_file(rf.color.at(frame), frame, r);
+    auto read = [&](RenderChannel c, int ch) {
+      const fs::path& p = rf.files[static_cast<size_t>(c)].at(frame);
+      torch::Tensor v;
+      try {
+        v = read_image(p);
+      } catch (const Error& e) {
+        throw Error(p.string(), "frame " + std::to_string(frame) + ": " + e.message(), e.kind());
+      }
+      check_image_size(v, r, p.string(), frame);
+      if (v.size(0) < ch)
+        throw Error(p.string(), "frame " + std::to_string(frame) + ": has " + std::to_string(v.size(0)) +
+                                    " channel(s), expected at least " + std::to_string(ch));
+      check_finite(v, p.string(), frame, channel_name(c).c_str());
+      return std::make_pair(v.slice(0, 0, ch).contiguous(), p.string());
+    };
+    torch::Tensor depth;
+    for (auto c : channels) {
+      if (c == RenderChannel::Depth) {
+        auto [v, path] = read(c, 1);
+        if (linear_depth_) {
+          if ((v < 0).any().item<bool>()) throw Error(path, "frame " + std::to_string(frame) + ": negative depth");
+          depth = torch::where(v == 0, torch::full({}, std::numeric_limits<float>::infinity()), v);
+        } else {
+          depth = linearize_depth(v, info_.near_plane, info_.far_plane);
+        }
+        f.depth = depth;
+      }
+    }
+    for (auto c : channels) {
+      switch (c) {
+        case RenderChannel::Depth: break;
+        case RenderChannel::Normal: {
+          auto [v, path] = read(c, 3);
+          auto n = v * 2 - 1;
+          if (depth.defined()) check_unit_normals(n, depth, path, frame);
+          f.normal = n.to(torch::kFloat16);
+          break;
+        }
+        case RenderChannel::NormalAngle: f.normal_angle = read(c, 1).first.to(torch::kFloat16); break;
+        case RenderChannel::Edge: f.edge = (read(c, 1).first > 0.5f).to(torch::kUInt8); break;
+        case RenderChannel::Motion: f.motion = read(c, 2).first; break;
+      }
+    }
+    return f;
+  }
+
+ private:
+  DatasetInfo info_;
+  std::vector<ResolutionFiles> res_;
+  bool linear_depth_ = false;
+};
+
+fs::path glob_yaml(const fs::path& path) { return fs::is_directory(path) ? path / "dataset.yaml" : path; }
+
+}  // namespace
+
+bool looks_like_glob_layout(const fs::path& path) {
+  const fs::path yaml = glob_yaml(path);
+  if (!fs::is_regular_file(yaml)) return false;
+  const auto ext = yaml.extension().string();
+  if (ext != ".yaml" && ext != ".yml") return false;
+  try {
+    const YAML::Node n = YAML::LoadFile(yaml.string());
+    return n.IsMap() && n["layout"] && n["layout"].IsScalar() && n["layout"].Scalar() == "glob";
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+std::unique_ptr<FrameSource> open_glob_layout(const fs::path& path, const DatasetOpenOptions& options) {
+  return std::make_unique<GlobDataset>(glob_yaml(path), options);
+}
+
+}  // namespace cgsr

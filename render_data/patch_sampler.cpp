@@ -1,0 +1,202 @@
+#include "render_data/patch_sampler.h"
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_group.h>
+#include <torch/torch.h>
+
+#include <deque>
+
+#include "core/error.h"
+#include "core/runtime.h"
+#include "render_data/augment.h"
+
+namespace cgsr {
+
+std::pair<size_t, size_t> resolution_pair(const Dataset& data, int scale, int lr_width) {
+  const auto& rs = data.resolutions();
+  std::vector<std::string> names;
+  for (const auto& r : rs) names.push_back(r.name());
+  if (scale < 1) throw Error("sampler", "scale must be at least 1");
+  for (size_t lo = 0; lo < rs.size(); ++lo) {
+    if (lr_width > 0 && rs[lo].width != lr_width) continue;
+    for (size_t hi = 0; hi < rs.size(); ++hi)
+      if (rs[hi].width == scale * rs[lo].width && rs[hi].height == scale * rs[lo].height) return {lo, hi};
+  }
+  throw Error(data.info().root.string(), "has no resolution pair with scale " + std::to_string(scale) +
+                                             (lr_width > 0 ? " and LR width " + std::to_string(lr_width) : "") +
+                                             " (resolutions: " + join(names) + ")");
+}
+
+namespace {
+
+// Both resolutions must carry every channel a batch needs.
+void require_channels(const Dataset& data, const std::vector<RenderChannel>& channels, size_t lo, size_t hi) {
+  for (size_t r : {lo, hi}) {
+    const auto& here = channels_at(data.info(), r);
+    for (auto c : channels)
+      if (std::find(here.begin(), here.end(), c) == here.end())
+        throw Error(data.info().root.string(), "batches need channel '" + channel_name(c) + "' at " +
+                                                   data.resolutions()[r].name() + ", which the dataset does not provide there" +
+                                                   (here.empty() ? std::string() : " (it has: " + join(channel_names(here)) + ")"));
+  }
+}
+
+// One (LR, HR) pair of windows, augmented, as float tensors.
+struct Item {
+  torch::Tensor lr_color, lr_info, hr_color, hr_info;
+};
+
+Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int s,
+               const std::vector<RenderChannel>& channels, double near_plane, double far_plane, const Augmentation* aug) {
+  const Frame l = crop(lr, x, y, w, h), H = crop(hr, s * x, s * y, s * w, s * h);
+  Item it;
+  it.lr_color = l.color_float();
+  it.hr_color = H.color_float();
+  it.lr_info = l.info(channels, near_plane, far_plane);
+  it.hr_info = H.info(channels, near_plane, far_plane);
+  if (aug) {
+    it.lr_color = augment_image(it.lr_color, *aug);
+    it.hr_color = augment_image(it.hr_color, *aug);
+    it.lr_info = augment_info(it.lr_info, channels, *aug);
+    it.hr_info = augment_info(it.hr_info, channels, *aug);
+  }
+  return it;
+}
+
+Batch stack(std::vector<Item>& items, const std::vector<RenderChannel>& channels, std::vector<int> frames, int scale) {
+  Batch b;
+  std::vector<torch::Tensor> lc, li, hc, hi;
+  for (auto& it : items) {
+    lc.push_back(it.lr_color);
+    li.push_back(it.lr_info);
+    hc.push_back(it.hr_color);
+    hi.push_back(it.hr_info);
+  }
+  b.lr_color = torch::stack(lc);
+  b.hr_color = torch::stack(hc);
+  b.lr_info = torch::stack(li);
+  b.hr_info = torch::stack(hi);
+  b.channels = channels;
+  b.frames = std::move(frames);
+  b.scale = scale;
+  return b;
+}
+
+}  // namespace
+
+struct PatchSampler::Prefetch {
+  struct Slot {
+    int64_t index = 0;
+    std::unique_ptr<tbb::task_group> group;
+    Batch batch;
+  };
+  std::deque<std::unique_ptr<Slot>> slots;
+  ~Prefetch() {
+    for (auto& s : slots) {
+      s->group->cancel();
+      try {
+        s->group->wait();
+      } catch (...) {
+        // A cancelled batch's error no longer matters.
+      }
+    }
+  }
+};
+
+PatchSampler::PatchSampler(Dataset data, PatchSamplerOptions options)
+    : data_(std::move(data)), options_(std::move(options)), prefetch_(std::make_unique<Prefetch>()) {
+  const auto& o = options_;
+  if (o.patch_size < 1 || o.batch_size < 1) throw Error("sampler", "patch and batch must be at least 1");
+  if (o.prefetch < 0) throw Error("sampler", "prefetch must be >= 0");
+  std::tie(lr_, hr_) = resolution_pair(data_, o.scale, o.lr_width);
+  const Resolution& lr = data_.resolutions()[lr_];
+  if (o.patch_size > lr.width || o.patch_size > lr.height)
+    throw Error("sampler", "LR patch " + std::to_string(o.patch_size) + " is larger than the LR frames " + lr.name());
+  require_channels(data_, o.channels, lr_, hr_);
+  frames_ = data_.frames(o.split);
+  if (frames_.empty()) throw Error(data_.info().root.string(), "the " + split_name(o.split) + " split has no frames");
+}
+
+PatchSampler::~PatchSampler() = default;
+
+Batch PatchSampler::build(int64_t k) const {
+  const auto& o = options_;
+  const Resolution lr = data_.resolutions()[lr_];
+  const auto& info = data_.info();
+  // Draw every item's choices first from one stream: the batch depends only on (seed, k).
+  struct Choice {
+    int frame, x, y, aug;
+  };
+  std::vector<Choice> choices(o.batch_size);
+  auto rng = make_rng("patch-sampler", o.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(k));
+  for (auto& c : choices) {
+    c.frame = frames_[rng() % frames_.size()];
+    c.x = static_cast<int>(rng() % static_cast<uint64_t>(lr.width - o.patch_size + 1));
+    c.y = static_cast<int>(rng() % static_cast<uint64_t>(lr.height - o.patch_size + 1));
+    c.aug = o.augment ? static_cast<int>(rng() % 8) : 0;
+  }
+  std::vector<Item> items(o.batch_size);
+  tbb::parallel_for(0, o.batch_size, [&](int i) {
+    const Choice& c = choices[i];
+    const auto l = data_.frame(c.frame, lr_), h = data_.frame(c.frame, hr_);
+    const Augmentation aug = Augmentation::from_index(c.aug);
+    items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, info.near_plane, info.far_plane,
+                         o.augment ? &aug : nullptr);
+  });
+  std::vector<int> frames;
+  for (const auto& c : choices) frames.push_back(c.frame);
+  return stack(items, o.channels, frames, o.scale);
+}
+
+Batch PatchSampler::next() { return batch(next_); }
+
+Batch PatchSampler::batch(int64_t k) {
+  auto& slots = prefetch_->slots;
+  // A jump (e.g. a resumed run) drops what was prefetched for other batch numbers.
+  while (!slots.empty() && slots.front()->index != k) {
+    auto dropped = std::move(slots.front());
+    slots.pop_front();
+    dropped->group->cancel();
+    try {
+      dropped->group->wait();
+    } catch (...) {
+      // A dropped batch's error no longer matters.
+    }
+  }
+  // Keep batches k .. k + prefetch in flight.
+  while (static_cast<int>(slots.size()) <= options_.prefetch) {
+    auto slot = std::make_unique<Prefetch::Slot>();
+    slot->index = k + static_cast<int64_t>(slots.size());
+    slot->group = std::make_unique<tbb::task_group>();
+    Prefetch::Slot* raw = slot.get();
+    raw->group->run([this, raw] { raw->batch = build(raw->index); });
+    slots.push_back(std::move(slot));
+  }
+  std::unique_ptr<Prefetch::Slot> slot = std::move(slots.front());
+  slots.pop_front();
+  slot->group->wait();  // rethrows a loading error
+  next_ = k + 1;
+  return std::move(slot->batch);
+}
+
+Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<RenderChannel>& channels, int lr_width) {
+  const auto [lo, hi] = resolution_pair(data, scale, lr_width);
+  require_channels(data, channels, lo, hi);
+  const auto l = data.frame(frame, lo), h = data.frame(frame, hi);
+  const auto& info = data.info();
+  std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, info.near_plane, info.far_plane,
+                                    nullptr)};
+  return stack(items, channels, {frame}, scale);
+}
+
+FrameIterator::FrameIterator(Dataset data, FrameIteratorOptions options) : data_(std::move(data)), options_(std::move(options)) {
+  std::tie(lr_, hr_) = resolution_pair(data_, options_.scale, options_.lr_width);
+  require_channels(data_, options_.channels, lr_, hr_);
+  frames_ = data_.frames(options_.split);
+}
+
+Batch FrameIterator::get(int k) const {
+  return frame_batch(data_, frames_.at(k), options_.scale, options_.channels, data_.resolutions()[lr_].width);
+}
+
+}  // namespace cgsr

@@ -1,0 +1,96 @@
+#pragma once
+// Training and evaluation batches from a Dataset (dataset.h), as Batch (batch.h):
+//
+//   Dataset data = Dataset::open(dir);
+//   PatchSamplerOptions o;          // scale 2, 48x48 LR patches, 16 per batch, train split
+//   o.channels = parse_channels({"depth", "normal", "edge"});
+//   PatchSampler sampler(data, o);
+//   Batch b = sampler.next();       // lr_color [16,3,48,48], hr_color [16,3,96,96], lr_info, hr_info
+//   Batch c = sampler.batch(step);  // batch number `step`: what the step-th next() returns
+//
+//   FrameIterator frames(data, {/*scale=*/2, Split::Test, channels});
+//   for (int k = 0; k < frames.size(); ++k) { Batch b = frames.get(k); ... }   // N = 1, full frames
+//   Batch f = frame_batch(data, /*frame=*/12, /*scale=*/2, channels);          // any frame by index
+//
+// Patches: a random frame of the split, a random LR window, the HR window exactly `scale` times
+// it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), DESIGN.md). With
+// augment, each item gets one of the 8 flips/rotations, applied to every tensor; normals and
+// motion vectors are rotated/flipped as vectors (augment.h). Batch k depends only on the seed
+// and k (not on threads or timing), so a resumed training run sees the same data; batches are
+// built in the background (TBB), `prefetch` ahead of the last one asked for.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "render_data/batch.h"
+#include "render_data/dataset.h"
+
+namespace cgsr {
+
+struct PatchSamplerOptions {
+  int scale = 2;
+  int patch_size = 48;  // LR patch side; the HR patch side is scale x patch_size
+  int batch_size = 16;
+  Split split = Split::Train;
+  std::vector<RenderChannel> channels;  // rendering information in the batch (may be empty)
+  bool augment = true;
+  uint64_t seed = 0;
+  int prefetch = 2;  // batches built ahead
+  int lr_width = 0;  // LR resolution width; 0: the smallest with a scale-x partner
+};
+
+// The (LR, HR) resolution indices of `data` for `scale` (and an optional LR width).
+std::pair<size_t, size_t> resolution_pair(const Dataset& data, int scale, int lr_width = 0);
+
+class PatchSampler {
+ public:
+  PatchSampler(Dataset data, PatchSamplerOptions options);
+  ~PatchSampler();
+  PatchSampler(const PatchSampler&) = delete;
+  PatchSampler& operator=(const PatchSampler&) = delete;
+
+  Batch next();  // batch(number of batches returned so far)
+  // Batch number k; when k follows the previous request it is usually ready (prefetched).
+  Batch batch(int64_t k);
+  // Batch number k built now, on the calling thread's TBB arena, without touching the prefetch.
+  Batch build(int64_t k) const;
+  const PatchSamplerOptions& options() const { return options_; }
+
+ private:
+  struct Prefetch;
+  Dataset data_;
+  PatchSamplerOptions options_;
+  size_t lr_, hr_;
+  std::vector<int> frames_;
+  int64_t next_ = 0;
+  std::unique_ptr<Prefetch> prefetch_;
+};
+
+struct FrameIteratorOptions {
+  int scale = 2;
+  Split split = Split::Test;
+  std::vector<RenderChannel> channels;
+  int lr_width = 0;
+};
+
+// One whole frame (N = 1) by frame index, LR/HR picked as in resolution_pair.
+Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<RenderChannel>& channels,
+                  int lr_width = 0);
+
+// Whole frames of a split, one Batch (N = 1) per frame, in frame order.
+class FrameIterator {
+ public:
+  FrameIterator(Dataset data, FrameIteratorOptions options);
+  int size() const { return static_cast<int>(frames_.size()); }
+  int frame_index(int k) const { return frames_.at(k); }
+  Batch get(int k) const;
+
+ private:
+  Dataset data_;
+  FrameIteratorOptions options_;
+  size_t lr_, hr_;
+  std::vector<int> frames_;
+};
+
+}  // namespace cgsr

@@ -1,0 +1,83 @@
+#pragma once
+// The "procedural" scene source: game-like levels generated from a few YAML options and a seed.
+//
+//   scene:
+//     type: procedural
+//     layout: room          # room | corridors | arena
+//     size: [10, 8]         # grid cells along x and z
+//     cell: 2.5             # metres per cell
+//     props: {crates: 6, pillars: 4, spheres: 3, tori: 2, stairs: 1, fences: 2, railings: 2, wires: 4, signs: 3}
+//     camera: {steps: 12, eye_height: 1.6, vfov: 70, yaw_sway: 20, speed_variation: 0.5}
+//
+// A level is a grid of cells: walls (room perimeter and partitions, a maze of corridors, or the
+// low boundary of an open arena under the sky) and free cells. The camera path is a random walk
+// over free cells, smoothed by the Catmull-Rom path of scene.h, with yaw/pitch/roll sway and
+// speed changes; props are placed only in cells the path does not visit, so the camera never
+// passes through geometry. Same options + seed = same scene.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "render_data/scene.h"
+
+namespace cgsr {
+
+struct ProceduralProps {
+  int crates = 6, pillars = 4, spheres = 3, tori = 2, stairs = 1, fences = 2, railings = 2, wires = 4, signs = 3;
+};
+
+struct ProceduralLighting {
+  int point_lights = 3;       // lamps under the ceiling (rooms, corridors) or on poles (arena)
+  float point_intensity = 2.5f;
+  bool sun = false;           // a directional light (always on in arenas)
+  float sun_intensity = 1.6f;
+  bool shadows = true;        // lights cast shadows (when the render enables shadow maps)
+  float ambient = 0.07f;      // linear ambient level
+};
+
+struct ProceduralCamera {
+  int steps = 12;             // cells visited by the walk (path length)
+  float eye_height = 1.6f;    // metres above the floor
+  float vfov = 70.0f;         // vertical field of view, degrees
+  float near_plane = 0.05f;
+  float far_plane = 300.0f;
+  float yaw_sway = 20.0f;     // degrees of look-around on top of the walking direction
+  float pitch_sway = 8.0f;    // degrees
+  float roll = 2.0f;          // degrees
+  float speed_variation = 0.5f;  // relative: speeds vary in [1 - v, 1 + v]
+};
+
+struct ProceduralFog {
+  float density = 0.0f;
+  float start = 0.0f;
+  std::vector<float> color = {0.5f, 0.55f, 0.6f};
+};
+
+struct ProceduralOptions {
+  std::string name = "procedural";
+  std::string layout = "room";
+  std::vector<int> size = {10, 8};
+  float cell = 2.5f;
+  float height = 4.0f;       // wall height (arena: boundary wall height)
+  bool ceiling = true;       // rooms and corridors: closed ceiling (arenas never have one)
+  int texture_size = 128;    // texels per side of each procedural texture
+  float texel_density = 100; // texels per metre on walls and floors (texture repeats accordingly)
+  ProceduralProps props;
+  ProceduralLighting lighting;
+  ProceduralCamera camera;
+  ProceduralFog fog;
+  std::vector<float> sky_horizon = {0.55f, 0.65f, 0.8f};
+  std::vector<float> sky_zenith = {0.15f, 0.3f, 0.65f};
+};
+
+config::Schema<ProceduralOptions> procedural_schema();
+
+// Builds the level; throws cgsr::Error when the layout leaves no room for the camera walk.
+SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed);
+
+// Registers "procedural" in the scene-source registry (called by register_builtin_scene_sources).
+void register_procedural_scene_source();
+
+}  // namespace cgsr

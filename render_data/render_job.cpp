@@ -1,0 +1,142 @@
+#include "render_data/render_job.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "core/error.h"
+#include "render_data/frame_files.h"
+#include "render_data/renderer.h"
+#include "render_data/scene_source.h"
+
+namespace cgsr {
+namespace fs = std::filesystem;
+
+config::Schema<EdgeSettings> edge_settings_schema() {
+  config::Schema<EdgeSettings> s;
+  s.field("depth_threshold", &EdgeSettings::depth_threshold,
+          "relative error of the linear 1/depth prediction across a pixel pair that makes a depth edge")
+      .range(1e-4, 10);
+  s.field("crease_angle", &EdgeSettings::crease_angle, "normal angle between neighbours that makes a crease edge, degrees")
+      .range(1, 180);
+  s.field("id_changes", &EdgeSettings::id_changes, "object id changes are edges");
+  return s;
+}
+
+std::vector<Resolution> parse_resolutions(const std::vector<std::string>& texts, const std::string& context) {
+  std::vector<Resolution> out;
+  for (const auto& t : texts) out.push_back(parse_resolution(t, context));
+  if (out.empty()) throw Error(context, "needs at least one resolution");
+  std::sort(out.begin(), out.end(), [](const Resolution& a, const Resolution& b) { return a.width < b.width; });
+  for (size_t i = 1; i < out.size(); ++i) {
+    const Resolution& lo = out.front();
+    const Resolution& r = out[i];
+    if (r == out[i - 1]) throw Error(context, "resolution " + r.name() + " is listed twice");
+    if (r.width % lo.width != 0 || r.height % lo.height != 0 || r.width / lo.width != r.height / lo.height)
+      throw Error(context, "resolution " + r.name() + " is not an integer scale of " + lo.name() +
+                               " (every resolution must be s x the smallest, s an integer)");
+  }
+  return out;
+}
+
+std::string human_bytes(double bytes) {
+  char buf[32];
+  if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.2f MB", bytes / 1e6);
+  else std::snprintf(buf, sizeof buf, "%.1f KB", bytes / 1e3);
+  return buf;
+}
+
+namespace {
+std::string fingerprint(const RenderJobOptions& o, uint64_t seed) {
+  std::string text = config::to_yaml(o.scene.node) + "|" + std::to_string(o.frames) + "|" + std::to_string(seed) + "|" +
+                     std::to_string(o.shadows) + "|" + std::to_string(o.shadow_map_size) + "|" +
+                     std::to_string(o.edges.depth_threshold) + "|" + std::to_string(o.edges.crease_angle) + "|" +
+                     std::to_string(o.edges.id_changes);
+  for (const auto& r : o.resolutions) text += "|" + r;
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+}  // namespace
+
+RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const fs::path& out,
+                               const std::function<void(int, int)>& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  const auto resolutions = parse_resolutions(o.resolutions, "resolutions");
+  register_builtin_scene_sources();
+  const SceneBundle bundle = make_scene(o.scene, seed);
+
+  RenderJobResult result;
+  DatasetManifest& m = result.manifest;
+  m.name = o.name.empty() ? bundle.scene.name : o.name;
+  m.fingerprint = fingerprint(o, seed);
+  m.frames = o.frames;
+  m.resolutions = resolutions;
+  m.near_plane = bundle.camera.near_plane;
+  m.far_plane = bundle.camera.far_plane;
+  m.vfov = bundle.camera.at_frame(0, o.frames).vfov;
+  m.scene_source = config::block_type(o.scene);
+  m.seed = seed;
+  m.split = make_split(o.frames);
+
+  fs::create_directories(out);
+  if (has_manifest(out)) {
+    const DatasetManifest previous = read_manifest(out);
+    if (previous.fingerprint != m.fingerprint)
+      throw Error(out.string(), "holds a render of a different configuration (manifest fingerprint " +
+                                    previous.fingerprint + ", this config " + m.fingerprint +
+                                    "); render into another --out directory");
+  }
+  write_manifest(out, m);  // complete: false until every frame is written
+
+  RenderSettings settings;
+  settings.shadows = o.shadows;
+  settings.shadow.map_size = o.shadow_map_size;
+  settings.edges = o.edges;
+  const SceneRenderer renderer(bundle.scene, settings);
+  result.triangles = renderer.geometry().triangle_count();
+  spdlog::info("scene '{}': {} triangles, {} lights, {} textures; {} frames at {}", bundle.scene.name, result.triangles,
+               bundle.scene.lights.size(), bundle.scene.textures.size(), o.frames, join(o.resolutions));
+
+  const auto& kinds = all_file_kinds();
+  result.bytes_per_kind.assign(resolutions.size(), std::vector<double>(kinds.size(), 0.0));
+  for (int f = 0; f < o.frames; ++f) {
+    if (frame_complete(out, resolutions, f)) {
+      ++result.skipped;
+    } else {
+      const CameraPose pose = bundle.camera.at_frame(f, o.frames), previous = bundle.camera.at_frame(f - 1, o.frames);
+      for (const auto& r : resolutions) {
+        const GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane);
+        write_frame_files(out, r, f, g);
+      }
+      ++result.rendered;
+    }
+    // Sizes from disk, so resumed frames count too.
+    for (size_t ri = 0; ri < resolutions.size(); ++ri)
+      for (size_t k = 0; k < kinds.size(); ++k)
+        result.bytes_per_kind[ri][k] += static_cast<double>(fs::file_size(frame_file(out, resolutions[ri], kinds[k], f)));
+    if (progress) progress(f + 1, o.frames);
+  }
+  for (size_t ri = 0; ri < resolutions.size(); ++ri) {
+    double total = 0;
+    for (auto& b : result.bytes_per_kind[ri]) total += (b /= o.frames);
+    m.bytes_per_frame.push_back(total);
+  }
+  m.complete = true;
+  write_manifest(out, m);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (result.skipped > 0) spdlog::info("resumed: {} frame(s) were already complete", result.skipped);
+  for (size_t ri = 0; ri < resolutions.size(); ++ri) {
+    std::string parts;
+    for (size_t k = 0; k < kinds.size(); ++k)
+      parts += (k ? ", " : "") + file_kind_name(kinds[k]) + " " + human_bytes(result.bytes_per_kind[ri][k]);
+    spdlog::info("size per frame at {}: {} ({})", resolutions[ri].name(), human_bytes(m.bytes_per_frame[ri]), parts);
+  }
+  return result;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,78 @@
+#pragma once
+// `cgsr render` as a library call: build a scene from its source block, render every frame at
+// every resolution, write the dataset (frame_files.h) and its manifest. A killed render resumes:
+// frames whose files all exist are skipped, and the manifest's fingerprint makes sure the
+// directory holds a render of the same configuration.
+//
+// Render config (configs/scenes/*.yaml):
+//   name: default
+//   frames: 90
+//   resolutions: [320x240, 640x480]     # every one an integer multiple of the smallest
+//   shadows: true
+//   shadow_map_size: 1024
+//   edges: {depth_threshold: 0.08, crease_angle: 40, id_changes: true}
+//   scene: {type: procedural, ...}      # scene_source.h
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "render_data/dataset_manifest.h"
+#include "render_data/edges.h"
+
+namespace cgsr {
+
+struct RenderJobOptions {
+  std::string name;  // dataset name; empty: the scene's name
+  int frames = 90;
+  std::vector<std::string> resolutions = {"320x240", "640x480"};
+  bool shadows = true;
+  int shadow_map_size = 1024;
+  EdgeSettings edges;
+  config::Block scene;
+};
+
+config::Schema<EdgeSettings> edge_settings_schema();
+
+// Adds the render-job keys to a command schema whose options struct derives from RenderJobOptions.
+template <class T>
+void add_render_job_fields(config::Schema<T>& s) {
+  s.field("name", static_cast<std::string T::*>(&RenderJobOptions::name), "dataset name (default: the scene's name)");
+  s.field("frames", static_cast<int T::*>(&RenderJobOptions::frames), "frames to render").range(1, 1000000);
+  s.field("resolutions", static_cast<std::vector<std::string> T::*>(&RenderJobOptions::resolutions),
+          "resolutions WxH, each an integer multiple of the smallest")
+      .check([](const std::vector<std::string>& v) { return !v.empty(); }, "needs at least one resolution");
+  s.field("shadows", static_cast<bool T::*>(&RenderJobOptions::shadows), "render shadow maps for lights that cast shadows");
+  s.field("shadow_map_size", static_cast<int T::*>(&RenderJobOptions::shadow_map_size), "shadow map texels per side")
+      .range(16, 8192);
+  s.section("edges", static_cast<EdgeSettings T::*>(&RenderJobOptions::edges), edge_settings_schema(),
+            "edge detection thresholds");
+  s.block("scene", static_cast<config::Block T::*>(&RenderJobOptions::scene), "scene source {type: procedural, ...}");
+  s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.scene.node || o.scene.node.IsNull()) at.child("scene").fail(node, "missing required key 'scene'");
+  });
+}
+
+// Parses and checks the resolutions: sorted ascending; each must be an integer multiple (same
+// aspect) of the smallest, else a cgsr::Error naming the pair.
+std::vector<Resolution> parse_resolutions(const std::vector<std::string>& texts, const std::string& context);
+
+struct RenderJobResult {
+  DatasetManifest manifest;
+  int rendered = 0, skipped = 0;  // frames rendered now, frames found complete (resumed)
+  double seconds = 0;
+  size_t triangles = 0;
+  // Mean bytes per frame, per resolution and per file kind (all_file_kinds() order).
+  std::vector<std::vector<double>> bytes_per_kind;
+};
+
+// Renders into `out` (created if needed). `progress` is called after each frame (done, total).
+RenderJobResult run_render_job(const RenderJobOptions& options, uint64_t seed, const std::filesystem::path& out,
+                               const std::function<void(int, int)>& progress = {});
+
+// "1.2 MB", "340 KB": for size reports.
+std::string human_bytes(double bytes);
+
+}  // namespace cgsr

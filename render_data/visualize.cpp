@@ -1,0 +1,78 @@
+#include "render_data/visualize.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+#include "core/text.h"
+
+namespace cgsr {
+
+const std::vector<std::string>& preview_channel_names() {
+  static const std::vector<std::string> n = {"color", "depth", "normal", "normal_angle", "edge", "motion"};
+  return n;
+}
+
+PreviewChannel preview_channel_from_name(const std::string& name) {
+  const auto& names = preview_channel_names();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<PreviewChannel>(i);
+  throw Error("preview", "unknown channel '" + name + "'" + did_you_mean(name, names) + "; valid: " + join(names));
+}
+
+namespace {
+torch::Tensor require(const torch::Tensor& t, const char* name) {
+  if (!t.defined()) throw Error("preview", std::string("the frame has no '") + name + "' channel");
+  return t;
+}
+}  // namespace
+
+torch::Tensor visualize(const Frame& f, PreviewChannel channel, double near_plane, double far_plane, double motion_scale) {
+  switch (channel) {
+    case PreviewChannel::Color: return f.color_float();
+    case PreviewChannel::Depth: {
+      // Inverse depth reads well at every distance; normalize_depth is 1 at the far plane.
+      const auto d = 1.0f - normalize_depth(require(f.depth, "depth"), near_plane, far_plane);
+      return d.pow(0.5).expand({3, f.height, f.width}).contiguous();
+    }
+    case PreviewChannel::Normal: {
+      const auto n = require(f.normal, "normal").to(torch::kFloat32);
+      const auto sky = (n.abs().sum(0, true) == 0);
+      return torch::where(sky, torch::zeros({}), (n + 1) * 0.5f);
+    }
+    case PreviewChannel::NormalAngle:
+      return require(f.normal_angle, "normal_angle").to(torch::kFloat32).expand({3, f.height, f.width}).contiguous();
+    case PreviewChannel::Edge: return require(f.edge, "edge").to(torch::kFloat32).expand({3, f.height, f.width}).contiguous();
+    case PreviewChannel::Motion: {
+      const auto m = require(f.motion, "motion");
+      const auto angle = torch::atan2(m[1], m[0]);  // hue from direction
+      const auto mag = (m.norm(2, 0) / motion_scale).clamp(0, 1);
+      const float third = 2.0943951f;
+      auto r = (torch::cos(angle) * 0.5f + 0.5f) * mag;
+      auto g = (torch::cos(angle - third) * 0.5f + 0.5f) * mag;
+      auto b = (torch::cos(angle + third) * 0.5f + 0.5f) * mag;
+      return torch::stack({r, g, b}, 0);
+    }
+  }
+  return {};
+}
+
+torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels, double near_plane,
+                      double far_plane) {
+  if (hr.width % lr.width != 0 || hr.width / lr.width != hr.height / lr.height || hr.height % lr.height != 0)
+    throw Error("preview", "the HR frame is not an integer multiple of the LR frame");
+  const int s = hr.width / lr.width, gap = 4;
+  const int W = hr.width, H = hr.height;
+  auto canvas = torch::ones({3, static_cast<int64_t>(channels.size()) * (H + gap) - gap, 2 * W + gap});
+  for (size_t row = 0; row < channels.size(); ++row) {
+    // Motion is in pixels of its own resolution: scale the LR colour wheel like the HR one.
+    const auto a = visualize(lr, channels[row], near_plane, far_plane, 8.0 / s);
+    const auto b = visualize(hr, channels[row], near_plane, far_plane, 8.0);
+    const auto big = a.repeat_interleave(s, 1).repeat_interleave(s, 2);
+    const int64_t y = static_cast<int64_t>(row) * (H + gap);
+    canvas.slice(1, y, y + H).slice(2, 0, W).copy_(big);
+    canvas.slice(1, y, y + H).slice(2, W + gap, 2 * W + gap).copy_(b);
+  }
+  return canvas;
+}
+
+}  // namespace cgsr

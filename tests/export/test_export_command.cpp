@@ -1,0 +1,94 @@
+// `cgsr export` and `cgsr bench --onnx` through the real executable.
+
+#include <gtest/gtest.h>
+
+#include <torch/torch.h>
+
+#include "export/onnx_writer.h"
+#include "models/model_file.h"
+#include "tests/export/export_cases.h"
+#include "tests/support/cli_runner.h"
+
+namespace cgsr {
+namespace {
+
+TEST(ExportCommand, ExportsAModelFileAndVerifiesItInOnnxRuntimeAndOpenCv) {
+  const auto dir = test::scratch_dir("export-cli-onnx");
+  // A trained-looking CG-enhanced, shrunk network saved as a model file.
+  SRNetwork net = test::build_network(test::with_rit(test::shrunk_pan(2), "hr_pooled", "concat", true), 1);
+  save_model(dir / "model.cgsr", *net);
+  const auto out = dir / "model.onnx";
+  const auto r = test::run_cgsr("export --model " + (dir / "model.cgsr").string() +
+                                " --format onnx --input 12x10 --verify --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NO_THROW(check_onnx_file(out));
+  EXPECT_NE(r.out.find("lr_render_info [1, 6, 20, 24]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ONNX checker ok"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("2 passed, 0 failed, 0 skipped"), std::string::npos) << r.out;
+  for (const char* runtime : {"onnxruntime", "opencv-dnn"}) EXPECT_NE(r.out.find(runtime), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ExportCommand, SizeFreeExportsVerifyAtTwoSizesAndSayWhyOpenCvIsSkipped) {
+  const auto dir = test::scratch_dir("export-cli-dynamic");
+  const auto onnx = test::run_cgsr("export --model edsr --scale 3 --format onnx --input 12x10 --dynamic-size --verify "
+                                   "--out " + (dir / "edsr.onnx").string());
+  ASSERT_EQ(onnx.exit_code, 0) << onnx.out << onnx.err;
+  EXPECT_NE(onnx.out.find("2 passed, 0 failed, 2 skipped"), std::string::npos) << onnx.out;
+  EXPECT_NE(onnx.out.find("skipped: OpenCV DNN 4.6 imports DepthToSpace"), std::string::npos) << onnx.out;
+  EXPECT_NE(onnx.out.find("9x6"), std::string::npos) << onnx.out;  // the second size
+  EXPECT_TRUE(inspect_onnx_file(dir / "edsr.onnx").dynamic());
+
+  const auto ts = test::run_cgsr("export --model srcnn --scale 2 --format torchscript --input 12x10 --verify --out " +
+                                 (dir / "srcnn.pt").string());
+  ASSERT_EQ(ts.exit_code, 0) << ts.out << ts.err;
+  EXPECT_NE(ts.out.find("4 passed, 0 failed, 0 skipped"), std::string::npos) << ts.out;
+  for (const char* runtime : {"libtorch", "python-torch"}) EXPECT_NE(ts.out.find(runtime), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ExportCommand, BadArgumentsAreClearErrors) {
+  const auto dir = test::scratch_dir("export-cli-errors");
+  const auto out = " --out " + (dir / "x.onnx").string();
+  const auto format = test::run_cgsr("export --model pan --format onnxx" + out);
+  EXPECT_EQ(format.exit_code, 2);
+  EXPECT_NE(format.err.find("did you mean 'onnx'"), std::string::npos) << format.err;
+  const auto model = test::run_cgsr("export --model nosuchnet --format onnx" + out);
+  EXPECT_EQ(model.exit_code, 2);
+  EXPECT_NE(model.err.find("nosuchnet"), std::string::npos) << model.err;
+  const auto dynamic = test::run_cgsr("export --model pan --format torchscript --dynamic-size" + out);
+  EXPECT_EQ(dynamic.exit_code, 2);
+  EXPECT_NE(dynamic.err.find("dynamic_size"), std::string::npos) << dynamic.err;
+  const auto no_out = test::run_cgsr("export --model pan");
+  EXPECT_EQ(no_out.exit_code, 2);
+  EXPECT_NE(no_out.err.find("out"), std::string::npos) << no_out.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.onnx"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BenchCommand, TimesAnOnnxFileInOnnxRuntimeNextToOurForward) {
+  const auto dir = test::scratch_dir("export-cli-bench");
+  const auto file = (dir / "pan.onnx").string();
+  ASSERT_EQ(test::run_cgsr("export --model pan --format onnx --input 12x10 --out " + file).exit_code, 0);
+  // --onnx alone: our side is built from the spec the file records.
+  const auto r = test::run_cgsr("bench --onnx " + file + " --input 12x10 --warmup 1 --runs 3 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["results"].size(), 2u);
+  EXPECT_EQ(j["results"][0]["runtime"], "libtorch");
+  EXPECT_EQ(j["results"][1]["runtime"], "onnxruntime");
+  EXPECT_GT(j["results"][1]["median_ms"].get<double>(), 0.0);
+  EXPECT_NEAR(j["onnxruntime_vs_libtorch"].get<double>(),
+              j["results"][1]["median_ms"].get<double>() / j["results"][0]["median_ms"].get<double>(), 1e-9);
+  // A fixed-size file timed at another size, or against another model, is refused clearly.
+  const auto size = test::run_cgsr("bench --onnx " + file + " --input 16x16 --runs 1");
+  EXPECT_EQ(size.exit_code, 2);
+  EXPECT_NE(size.err.find("fixed at another size"), std::string::npos) << size.err;
+  const auto other = test::run_cgsr("bench --model edsr --onnx " + file + " --input 12x10 --runs 1");
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("is an export of pan x2, not of edsr x2"), std::string::npos) << other.err;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cgsr

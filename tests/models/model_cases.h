@@ -1,0 +1,58 @@
+#pragma once
+// Shared fixtures of the models tests: every backbone at every scale, and small inputs.
+
+#include <torch/torch.h>
+
+#include <string>
+#include <vector>
+
+#include "models/arch_spec.h"
+
+namespace cgsr::test {
+
+struct BackboneCase {
+  std::string backbone;
+  int scale;
+  std::string colors;
+};
+
+inline std::vector<BackboneCase> all_backbone_cases() {
+  std::vector<BackboneCase> cases;
+  for (const char* b : {"srcnn", "edsr", "pan"})
+    for (int s : {2, 3, 4}) cases.push_back({b, s, "rgb"});
+  for (int s : {2, 3, 4}) cases.push_back({"srcnn", s, "y"});
+  return cases;
+}
+
+inline ArchSpec spec_for(const BackboneCase& c) {
+  ArchSpec s = default_spec(c.backbone, c.scale);
+  s.colors = c.colors;
+  return resolve_spec(s);
+}
+
+inline std::string case_name(const BackboneCase& c) {
+  return c.backbone + " x" + std::to_string(c.scale) + (c.colors == "y" ? " (Y)" : "");
+}
+
+// A spec with a RIT reading every channel the paper uses.
+inline ArchSpec with_rit(ArchSpec s, const std::string& source = "lr", const std::string& fusion = "concat",
+                         bool geometry = false) {
+  s.rit.enabled = true;
+  s.rit.source = source;
+  s.rit.fusion = fusion;
+  s.geometry.enabled = geometry;
+  return resolve_spec(s);
+}
+
+// Random colour and rendering information for a spec, LR size w x h.
+inline std::pair<torch::Tensor, torch::Tensor> random_inputs(const ArchSpec& s, int64_t w, int64_t h, int64_t n = 1) {
+  const auto color = torch::rand({n, 3, h, w});
+  torch::Tensor info;
+  if (s.rit.enabled) {
+    const int64_t f = s.rit.source == "hr_pooled" ? s.scale : 1;
+    info = torch::rand({n, static_cast<int64_t>(s.rit.info_width()), h * f, w * f});
+  }
+  return {color, info};
+}
+
+}  // namespace cgsr::test

@@ -1,0 +1,131 @@
+// The architecture spec: defaults, YAML round trips, and validation errors that point at the
+// offending key with file:line:col.
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "models/arch_spec.h"
+#include "models/backbone_registry.h"
+#include "tests/models/model_cases.h"
+
+using namespace cgsr;
+using namespace cgsr::test;
+
+namespace {
+std::string parse_error(const std::string& yaml) {
+  try {
+    spec_from_yaml(yaml, "spec.yaml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(ArchSpec, DefaultsListEveryGroupInOrder) {
+  const ArchSpec pan = default_spec("pan", 4);
+  EXPECT_EQ(pan.blocks, 16);
+  EXPECT_EQ(pan.widths.entries().size(), 1u + 16 * 5 + 4);
+  EXPECT_EQ(pan.widths.entries().front(), (std::pair<std::string, int>{"features", 40}));
+  EXPECT_EQ(pan.widths.at("block15_b_out"), 20);
+  EXPECT_EQ(pan.widths.at("hr2"), 24);
+  EXPECT_FALSE(default_spec("pan", 2).widths.contains("up2"));
+  const ArchSpec srcnn = default_spec("srcnn", 3);
+  EXPECT_EQ(srcnn.blocks, 0);
+  EXPECT_EQ(backbone_groups(srcnn), (std::vector<std::string>{"conv1", "conv2"}));
+  EXPECT_EQ(default_spec("edsr", 2).group_width("block7_mid"), 64);
+}
+
+TEST(ArchSpec, YamlRoundTripForEveryBackbone) {
+  for (const auto& c : all_backbone_cases()) {
+    SCOPED_TRACE(case_name(c));
+    for (bool rit : {false, true}) {
+      ArchSpec s = rit ? with_rit(spec_for(c), "hr_pooled", "add", true) : spec_for(c);
+      if (rit) {
+        s.rit.width = 7;
+        s.widths.set(backbone_groups(s).back(), 3);
+      }
+      const ArchSpec back = spec_from_yaml(spec_to_yaml(s), "roundtrip");
+      EXPECT_EQ(back, s) << spec_to_yaml(s);
+    }
+  }
+}
+
+TEST(ArchSpec, FilesRoundTripAtomically) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cgsr-spec-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  ArchSpec s = with_rit(default_spec("edsr", 4));
+  s.blocks = 5;
+  s.widths = GroupWidths();
+  s = resolve_spec(s);
+  save_spec_file(dir / "edsr.yaml", s);
+  EXPECT_EQ(load_spec_file(dir / "edsr.yaml"), s);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ArchSpec, PartialSpecsTakeBackboneDefaults) {
+  const ArchSpec s = spec_from_yaml("backbone: pan\nscale: 3\nblocks: 4\nwidths: {features: 32, block2_att: 8}\n"
+                                    "rit: {enabled: true, channels: [edge, depth]}\n",
+                                    "partial");
+  EXPECT_EQ(s.blocks, 4);
+  EXPECT_EQ(s.widths.at("features"), 32);
+  EXPECT_EQ(s.widths.at("block2_att"), 8);
+  EXPECT_EQ(s.widths.at("block2_a"), 20);
+  EXPECT_EQ(s.widths.at("up1"), 24);
+  EXPECT_EQ(s.widths.entries().front().first, "features");  // canonical order, not file order
+  EXPECT_EQ(s.rit.channels, (std::vector<std::string>{"depth", "edge"}));
+  EXPECT_EQ(s.rit.info_width(), 2);
+}
+
+TEST(ArchSpec, TyposPointAtFileLineAndColumn) {
+  std::string e = parse_error("backbone: pan\nwidhts: {features: 32}\n");
+  EXPECT_NE(e.find("spec.yaml:2:1"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'widths'"), std::string::npos) << e;
+
+  e = parse_error("backbone: pan\nwidths:\n  featurs: 32\n");
+  EXPECT_NE(e.find("spec.yaml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'features'"), std::string::npos) << e;
+
+  e = parse_error("backbone: pan\nblocks: 2\nwidths:\n  block5_a: 8\n");
+  EXPECT_NE(e.find("spec.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("with 2 blocks"), std::string::npos) << e;
+
+  e = parse_error("backbone: edsr\nwidths:\n  up1: 0\n");
+  EXPECT_NE(e.find("spec.yaml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("at least 1"), std::string::npos) << e;
+
+  e = parse_error("backbone: edsr\nwidths:\n  up1: wide\n");
+  EXPECT_NE(e.find("expected an integer"), std::string::npos) << e;
+
+  e = parse_error("backbone: pam\n");
+  EXPECT_NE(e.find("spec.yaml:1:"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'pan'"), std::string::npos) << e;
+
+  e = parse_error("backbone: pan\nrit:\n  enabled: true\n  channels: [dpeth]\n");
+  EXPECT_NE(e.find("spec.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'depth'"), std::string::npos) << e;
+
+  e = parse_error("backbone: pan\nrit: {enabled: true, fusion: concatenate}\n");
+  EXPECT_NE(e.find("not one of: concat, add"), std::string::npos) << e;
+}
+
+TEST(ArchSpec, InconsistentCombinationsAreErrors) {
+  EXPECT_NE(parse_error("backbone: pan\ncolors: y\n").find("srcnn"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: srcnn\nblocks: 3\n").find("no residual blocks"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: pan\nscale: 5\n").find("scale"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: pan\ngeometry: {enabled: true}\n").find("enable rit"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: pan\nrit: {enabled: true, channels: []}\n").find("at least one"),
+            std::string::npos);
+  EXPECT_NE(parse_error("backbone: edsr\nblocks: 0\n").find("blocks must be in [1, 64]"), std::string::npos);
+}
+
+TEST(ArchSpec, ProgrammaticSpecsAreValidatedToo) {
+  ArchSpec s = default_spec("pan", 2);
+  s.widths.set("features", -3);
+  try {
+    validate_spec(s);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.context(), "arch spec: widths.features");
+  }
+  EXPECT_THROW(resolve_spec(s), Error);
+}

@@ -1,0 +1,135 @@
+// The rendering information transform: identity at initialization (a CG-enhanced network built
+// from a trained backbone computes exactly the backbone's output), gates, shapes, inputs.
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "models/inherit.h"
+#include "models/sr_network.h"
+#include "tests/models/model_cases.h"
+
+using namespace cgsr;
+using namespace cgsr::test;
+
+TEST(Rit, EnhancedNetworkEqualsItsBackboneAtInitialization) {
+  torch::manual_seed(3);
+  for (const auto& c : all_backbone_cases()) {
+    SRNetwork backbone(spec_for(c));
+    for (const char* source : {"lr", "hr_pooled"})
+      for (const char* fusion : {"concat", "add"}) {
+        SCOPED_TRACE(case_name(c) + " " + source + " " + fusion);
+        const ArchSpec cg = with_rit(spec_for(c), source, fusion, /*geometry=*/true);
+        auto child = inherit(*backbone, cg);
+        EXPECT_FALSE(child.fresh.empty());
+        const auto [color, info] = random_inputs(cg, 6, 5);
+        torch::NoGradGuard no_grad;
+        EXPECT_TRUE(torch::equal(child.network->forward(color, info), backbone->forward(color)));
+      }
+  }
+}
+
+TEST(Rit, InfoChangesTheOutputOnceTheFusionLearns) {
+  torch::manual_seed(4);
+  SRNetwork net(with_rit(default_spec("pan", 2)));
+  const auto [color, info] = random_inputs(net->spec(), 6, 6);
+  torch::NoGradGuard no_grad;
+  const auto before = net->forward(color, info);
+  net->rit()->fuse->weight.normal_(0, 0.1);
+  EXPECT_FALSE(torch::equal(net->forward(color, info), before));
+  // A zero gate switches the rendering information off entirely.
+  net->rit()->gate.zero_();
+  const auto gated = net->forward(color, info);
+  EXPECT_TRUE(torch::equal(gated, net->forward(color, torch::rand_like(info))));
+}
+
+TEST(Rit, GateIsAParameterWithOneEntryPerInputChannel) {
+  SRNetwork net(with_rit(default_spec("edsr", 2)));
+  const auto gate = net->rit_gate();
+  ASSERT_TRUE(gate.defined());
+  EXPECT_EQ(gate.numel(), 6);  // depth 1 + normal 3 + normal_angle 1 + edge 1
+  EXPECT_TRUE(gate.requires_grad());
+  EXPECT_TRUE(torch::equal(gate, torch::ones({6})));
+  EXPECT_FALSE(SRNetwork(default_spec("edsr", 2))->rit_gate().defined());
+}
+
+TEST(Rit, JointLossGradientsReachGateAndImportances) {
+  torch::manual_seed(5);
+  SRNetwork net(with_rit(default_spec("pan", 2), "lr", "concat", true));
+  {
+    torch::NoGradGuard no_grad;
+    net->rit()->fuse->weight.normal_(0, 0.1);
+  }
+  const auto [color, info] = random_inputs(net->spec(), 6, 6);
+  const auto out = net->forward_train(color, info);
+  ASSERT_TRUE(out.geometry.defined());
+  EXPECT_EQ(out.geometry.sizes().vec(), (std::vector<int64_t>{1, 6, 12, 12}));
+  const auto importance = net->channel_importance();
+  ASSERT_TRUE(importance.count("block0_a"));
+  EXPECT_EQ(importance.at("block0_a").numel(), 20);
+  EXPECT_EQ(importance.at("features").numel(), 40);
+  EXPECT_EQ(importance.at("rit").numel(), 16);
+  EXPECT_FALSE(importance.count("geometry"));
+  const auto loss = out.image.mean() + out.geometry.abs().mean() + net->rit_gate().abs().sum() +
+                    importance.at("block0_a").index_select(0, torch::tensor({0, 3})).sum();
+  loss.backward();
+  EXPECT_GT(net->rit_gate().grad().abs().sum().item<float>(), 0.f);
+  const auto& k = net->named_parameters()["backbone.blocks.0.conv1_a.weight"];
+  ASSERT_TRUE(k.grad().defined());
+  EXPECT_GT(k.grad()[0].abs().sum().item<float>(), 0.f);
+}
+
+TEST(Rit, ImportanceIsTheL1NormOfProducingWeights) {
+  SRNetwork net(default_spec("edsr", 2));
+  const auto imp = net->channel_importance();
+  const auto p = net->named_parameters();
+  const auto& w = p["backbone.blocks.2.conv1.weight"];
+  const auto& b = p["backbone.blocks.2.conv1.bias"];
+  EXPECT_TRUE(torch::allclose(imp.at("block2_mid"), w.abs().sum({1, 2, 3}) + b.abs()));
+  // up1 (pixel shuffle): each channel sums its 4 sub-channels.
+  const auto& uw = p["backbone.upsample1.weight"];
+  const auto& ub = p["backbone.upsample1.bias"];
+  const auto per_position = uw.abs().sum({1, 2, 3}) + ub.abs();
+  EXPECT_TRUE(torch::allclose(imp.at("up1"), per_position.view({64, 4}).sum(1)));
+}
+
+TEST(Rit, WrongInfoShapesAreClearErrors) {
+  SRNetwork lr(with_rit(default_spec("pan", 2)));
+  SRNetwork hr(with_rit(default_spec("pan", 2), "hr_pooled"));
+  const auto color = torch::rand({1, 3, 4, 4});
+  EXPECT_THROW(lr->forward(color), Error);
+  EXPECT_THROW(lr->forward(color, torch::rand({1, 6, 8, 8})), Error);
+  EXPECT_NO_THROW(hr->forward(color, torch::rand({1, 6, 8, 8})));
+  try {
+    lr->forward(color, torch::rand({1, 5, 4, 4}));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("depth, normal, normal_angle, edge"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Rit, NetworkTakesItsChannelsFromABatch) {
+  ArchSpec s = default_spec("pan", 2);
+  s.rit.enabled = true;
+  s.rit.channels = {"edge", "depth"};
+  s.geometry.enabled = true;
+  s = resolve_spec(s);
+  EXPECT_EQ(s.rit.channels, (std::vector<std::string>{"depth", "edge"}));  // canonical order
+  SRNetwork net(s);
+  Batch batch;
+  batch.scale = 2;
+  batch.channels = {RenderChannel::Depth, RenderChannel::Normal, RenderChannel::Edge};
+  batch.lr_info = torch::arange(5).view({1, 5, 1, 1}).expand({1, 5, 3, 3}).to(torch::kFloat);
+  batch.hr_info = torch::arange(5).view({1, 5, 1, 1}).expand({1, 5, 6, 6}).to(torch::kFloat);
+  const auto info = net->info_input(batch);
+  EXPECT_EQ(info.sizes().vec(), (std::vector<int64_t>{1, 2, 3, 3}));
+  EXPECT_EQ(info[0][0][0][0].item<float>(), 0.f);  // depth
+  EXPECT_EQ(info[0][1][0][0].item<float>(), 4.f);  // edge, after the 3 normal channels
+  EXPECT_EQ(net->geometry_target(batch).sizes().vec(), (std::vector<int64_t>{1, 2, 6, 6}));
+  batch.channels = {RenderChannel::Depth};
+  batch.lr_info = torch::zeros({1, 1, 3, 3});
+  try {
+    net->info_input(batch);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'edge'"), std::string::npos) << e.what();
+  }
+}

@@ -1,0 +1,122 @@
+#pragma once
+// Shared fixtures of the pruning tests: small networks of every backbone (with and without a
+// RIT, pixel-shuffle and attention groups included), random weights, random pattern pools, and
+// the masked dense reference computation a pattern's execution must equal.
+
+#include <torch/torch.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "models/arch_spec.h"
+#include "models/sr_network.h"
+#include "pruning/pattern_pool.h"
+#include "pruning/prunable_units.h"
+
+namespace cgsr::test {
+
+struct NetCase {
+  std::string name;
+  ArchSpec spec;
+};
+
+// A backbone with `blocks` blocks and every layer group `width` wide (features `features`).
+inline ArchSpec small_spec(const std::string& backbone, int scale, int blocks, int width, int features,
+                           bool rit = false) {
+  ArchSpec s = default_spec(backbone, scale);
+  if (backbone != "srcnn") s.blocks = blocks;
+  s.widths = GroupWidths();
+  s = resolve_spec(s);
+  GroupWidths w;
+  for (const auto& [group, unused] : s.widths.entries()) w.set(group, group == "features" ? features : width);
+  s.widths = w;
+  if (rit) {
+    s.rit.enabled = true;
+    s.rit.channels = {"depth", "normal_angle", "edge"};
+    s.rit.width = 5;
+  }
+  return resolve_spec(s);
+}
+
+inline std::vector<NetCase> net_cases() {
+  return {{"pan x2", small_spec("pan", 2, 2, 6, 8)},
+          {"pan x4 + rit", small_spec("pan", 4, 2, 6, 8, true)},
+          {"edsr x4", small_spec("edsr", 4, 2, 6, 8)},
+          {"edsr x3 + rit", small_spec("edsr", 3, 1, 5, 8, true)},
+          {"srcnn x2", small_spec("srcnn", 2, 0, 7, 7)}};
+}
+
+// Every parameter random (the RIT fusion starts at zero otherwise).
+inline void randomize(SRNetworkImpl& net) {
+  torch::NoGradGuard no_grad;
+  for (auto& p : net.parameters()) p.normal_(0, 0.2);
+}
+
+inline std::pair<torch::Tensor, torch::Tensor> inputs_for(const SRNetworkImpl& net, int64_t w, int64_t h,
+                                                           int64_t n = 1) {
+  const auto color = torch::rand({n, 3, h, w});
+  torch::Tensor info;
+  if (net.has_rit()) {
+    const int64_t f = net.rit()->info_factor();
+    info = torch::rand({n, static_cast<int64_t>(net.spec().rit.info_width()), h * f, w * f});
+  }
+  return {color, info};
+}
+
+// `k` random patterns per unit keeping kept_count(width, rate) channels of every group.
+inline PatternPool random_pool(const std::vector<PrunableUnit>& units, int k, double rate, uint32_t seed) {
+  std::mt19937 rng(seed);
+  PatternPool pool;
+  for (const auto& u : units) {
+    UnitPatterns up;
+    up.unit = u;
+    for (int i = 0; i < k; ++i) {
+      Pattern p;
+      p.frames = k - i;
+      for (size_t g = 0; g < u.groups.size(); ++g) {
+        std::vector<int64_t> all(u.widths[g]);
+        for (int64_t c = 0; c < u.widths[g]; ++c) all[c] = c;
+        std::shuffle(all.begin(), all.end(), rng);
+        all.resize(kept_count(u.widths[g], rate));
+        std::sort(all.begin(), all.end());
+        p.keep[u.groups[g]] = all;
+      }
+      up.patterns.push_back(p);
+    }
+    pool.units.push_back(up);
+  }
+  return pool;
+}
+
+// The reference: the dense network with every convolution's input columns of removed channels
+// set to zero (a copy of the weights), run by the graph interpreter. Removing a channel of a
+// pruning unit can only act through the convolutions reading it.
+inline torch::Tensor masked_dense(const SRNetworkImpl& net, const ChannelSelection& keep, const torch::Tensor& color,
+                                  const torch::Tensor& info) {
+  torch::NoGradGuard no_grad;
+  graph::Graph g = net.describe(false);
+  for (auto& op : g.ops) {
+    if (op.kind != graph::OpKind::Conv) continue;
+    auto w = op.weight.clone();
+    int64_t offset = 0;
+    for (const auto& s : g.values[op.inputs[0]].layout) {
+      const auto it = s.prunable ? keep.find(s.group) : keep.end();
+      if (it != keep.end())
+        for (int64_t c = 0; c < s.channels; ++c)
+          if (!std::binary_search(it->second.begin(), it->second.end(), c))
+            w.slice(1, offset + c * s.repeat, offset + (c + 1) * s.repeat).zero_();
+      offset += s.channels * s.repeat;
+    }
+    op.weight = w;
+  }
+  std::vector<std::pair<std::string, torch::Tensor>> in = {{"color", color}};
+  if (info.defined()) in.emplace_back("info", info);
+  return graph::run(g, in).front().second;
+}
+
+inline double max_diff(const torch::Tensor& a, const torch::Tensor& b) {
+  return (a - b).abs().max().item<double>();
+}
+
+}  // namespace cgsr::test

@@ -1,0 +1,71 @@
+// `cgsr prune` through the real executable on a tiny rendered scene: it writes a valid hybrid
+// model, the baseline and results; `cgsr eval` then records the per-frame patterns and
+// `cgsr report` tabulates the new rows.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "pruning/hybrid_model.h"
+#include "tests/pruning/pruning_cases.h"
+#include "tests/support/cli_runner.h"
+
+using namespace cgsr;
+using namespace cgsr::test;
+
+namespace {
+std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+nlohmann::json results_of(const std::filesystem::path& dir) { return nlohmann::json::parse(slurp(dir / "results.json")); }
+}  // namespace
+
+TEST(PruneCli, PrunesATinySceneEndToEnd) {
+  const auto dir = scratch_dir("prune-cli");
+  const std::string source = CGSR_SOURCE_DIR;
+  auto r = run_cgsr("render --config '" + source + "/configs/scenes/tiny.yaml' --out " + q(dir / "data"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  torch::manual_seed(18);
+  SRNetwork net(small_spec("pan", 2, 2, 6, 8, /*rit=*/true));
+  randomize(*net);
+  Provenance p;
+  p.extra = {{"name", "tiny"}};
+  save_model(dir / "model.cgsr", *net, p);
+
+  const std::string common = "prune --config '" + source + "/configs/prune/quick.yaml' --model " +
+                             q(dir / "model.cgsr") + " --data " + q(dir / "data") +
+                             " --set finetune.schedule.steps=3 --set warmup_steps=5 --set eval.latency_runs=1";
+  r = run_cgsr(common + " --out " + q(dir / "run"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const HybridModel h = load_hybrid_model(dir / "run" / "pruned.cgsr");
+  EXPECT_EQ(h.pool.units.size(), h.samplers->patterns().size());
+  for (const auto& u : h.pool.units) EXPECT_FALSE(u.patterns.empty());
+  EXPECT_TRUE(std::filesystem::exists(dir / "run" / "mmp.cgsr"));
+  const auto results = results_of(dir / "run");
+  ASSERT_EQ(results["evaluations"].size(), 4u);
+  EXPECT_EQ(results["evaluations"][0]["name"], "tiny");
+  EXPECT_EQ(results["evaluations"][1]["name"], "tiny MMP");
+  EXPECT_EQ(results["evaluations"][3]["name"], "tiny hybrid");
+  EXPECT_TRUE(results["left_out"].contains("channels"));
+  EXPECT_TRUE(results["left_out"]["geometry_head"].is_boolean());
+  EXPECT_LT(results["comparison"][3]["macs_ratio"].get<double>(), 1.0);
+  const auto frame = results["evaluations"][3]["frames"][0];
+  EXPECT_TRUE(frame["details"]["patterns"].contains("block0"));
+  EXPECT_GE(frame["details"]["choose_ms"].get<double>(), 0.0);
+
+  r = run_cgsr("eval --data " + q(dir / "data") + " --model " + q(dir / "run" / "pruned.cgsr") + " --out " +
+               q(dir / "eval"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto eval = results_of(dir / "eval");
+  EXPECT_EQ(eval["evaluations"][0]["name"], "tiny hybrid");
+  EXPECT_TRUE(eval["evaluations"][0]["frames"][0]["details"]["patterns"].is_object());
+
+  r = run_cgsr("report " + q(dir / "run") + " --out " + q(dir / "report"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(slurp(dir / "report" / "report.md").find("tiny hybrid"), std::string::npos);
+
+  r = run_cgsr("prune --config '" + source + "/configs/prune/quick.yaml' --model " + q(dir / "missing.cgsr") +
+               " --data " + q(dir / "data") + " --out " + q(dir / "bad"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing.cgsr"), std::string::npos) << r.err;
+  std::filesystem::remove_all(dir);
+}

@@ -1,0 +1,67 @@
+// The report: Pareto front, tables, CSV and plot from evaluation results.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/atomic_file.h"
+#include "train/report.h"
+
+using namespace cgsr;
+
+namespace {
+EvalResult row(const std::string& name, double psnr, std::optional<double> ms, std::optional<int64_t> params = {}) {
+  EvalResult r;
+  r.name = name;
+  r.dataset = "hall";
+  r.split = "test";
+  r.scale = 2;
+  r.psnr = psnr;
+  r.ssim = 0.9;
+  r.frames.resize(3);
+  if (ms) {
+    LatencyStats l;
+    l.median_ms = *ms;
+    r.latency = l;
+  }
+  if (params) {
+    Complexity c;
+    c.params = *params;
+    c.macs = *params * 1000;
+    r.cost = c;
+  }
+  return r;
+}
+}  // namespace
+
+TEST(Report, ParetoFrontKeepsOnlyUndominatedRows) {
+  ReportTable t{"hall", 2, {row("fast", 30, 1.0), row("slow-worse", 29, 5.0), row("slow-better", 33, 10.0),
+                            row("no-latency", 40, std::nullopt)}};
+  EXPECT_EQ(pareto_front(t), (std::vector<size_t>{0, 2}));
+}
+
+TEST(Report, GroupsByDatasetAndScale) {
+  auto a = row("a", 30, 1.0), b = row("b", 31, 2.0), c = row("c", 32, 3.0);
+  c.scale = 3;
+  const auto tables = group_results({a, c, b});
+  ASSERT_EQ(tables.size(), 2u);
+  EXPECT_EQ(tables[0].rows.size(), 2u);
+  EXPECT_EQ(tables[1].scale, 3);
+}
+
+TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}};
+  const auto md = report_markdown(t);
+  EXPECT_NE(md.find("| bicubic * | NA | NA | 0.50 | 30.12 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| pan * | 261.4 | 261.40 | 12.00 | 33.46 |"), std::string::npos) << md;
+  const auto csv = report_csv({t});
+  EXPECT_NE(csv.find("hall,2,pan,261403,261403000,12.0000,33.4560"), std::string::npos) << csv;
+}
+
+TEST(Report, PlotIsAPng) {
+  const auto path = std::filesystem::temp_directory_path() / "cgsr-report-plot.png";
+  ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), row("pan", 33, 12.0, 261403), row("fsr", 31, std::nullopt)}};
+  write_report_plot(path, t);
+  const auto bytes = read_file(path);
+  ASSERT_GT(bytes.size(), 1000u);
+  EXPECT_EQ(bytes.substr(1, 3), "PNG");
+}

@@ -1,0 +1,245 @@
+#include "train/evaluation.h"
+
+#include <spdlog/spdlog.h>
+#include <torch/torch.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "core/progress.h"
+#include "render_data/patch_sampler.h"
+#include "train/temporal.h"
+
+namespace cgsr {
+
+config::Schema<EvalOptions> eval_schema_fields() {
+  config::Schema<EvalOptions> s;
+  s.field("split", &EvalOptions::split, "data set split").one_of({"train", "val", "test", "all"});
+  s.field("max_frames", &EvalOptions::max_frames, "frames to evaluate (0 = the whole split)").at_least(0);
+  s.field("crop_border", &EvalOptions::crop_border, "HR pixels ignored at each border").range(0, 64);
+  s.field("y_channel", &EvalOptions::y_channel, "PSNR/SSIM on BT.601 luma instead of RGB");
+  s.field("temporal", &EvalOptions::temporal, "warping error between consecutive outputs");
+  s.field("latency_runs", &EvalOptions::latency_runs, "timed runs for the latency column (0 = skip)").range(0, 1000);
+  s.field("save_frames", &EvalOptions::save_frames, "directory for the upscaled frames (PNG); empty = none");
+  return s;
+}
+
+namespace {
+std::vector<int> pick_frames(const Dataset& data, const EvalOptions& options) {
+  std::vector<int> frames = data.frames(split_from_name(options.split));
+  if (frames.empty()) throw Error(data.info().root.string(), "split '" + options.split + "' has no frames");
+  if (options.max_frames > 0 && static_cast<size_t>(options.max_frames) < frames.size()) {
+    std::vector<int> picked;
+    for (int i = 0; i < options.max_frames; ++i) picked.push_back(frames[i * frames.size() / options.max_frames]);
+    frames = picked;
+  }
+  return frames;
+}
+
+std::vector<RenderChannel> with_motion(std::vector<RenderChannel> channels) {
+  if (std::find(channels.begin(), channels.end(), RenderChannel::Motion) == channels.end())
+    channels.push_back(RenderChannel::Motion);
+  std::sort(channels.begin(), channels.end());
+  return channels;
+}
+
+torch::Tensor hr_motion(const Batch& b) {
+  int offset = 0;
+  for (auto c : b.channels) {
+    if (c == RenderChannel::Motion) return b.hr_info.slice(1, offset, offset + channel_width(c));
+    offset += channel_width(c);
+  }
+  throw Error("evaluation", "the batch has no motion vectors", ErrorKind::Internal);
+}
+
+std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::optional<double> FrameScore::*field) {
+  double sum = 0;
+  int n = 0;
+  for (const auto& f : frames)
+    if (f.*field) {
+      sum += *(f.*field);
+      ++n;
+    }
+  return n ? std::optional<double>(sum / n) : std::nullopt;
+}
+}  // namespace
+
+EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options) {
+  EvalResult result;
+  result.name = upscaler.name();
+  result.dataset = data.info().name;
+  result.split = options.split;
+  result.scale = upscaler.scale();
+  const auto& available = data.info().channels;
+  const bool temporal =
+      options.temporal && std::find(available.begin(), available.end(), RenderChannel::Motion) != available.end();
+  if (options.temporal && !temporal)
+    spdlog::warn("{}: no motion vectors, temporal error skipped", data.info().root.string());
+  const auto channels = temporal ? with_motion(upscaler.channels()) : upscaler.channels();
+  QualityOptions quality;
+  quality.crop_border = options.crop_border;
+  quality.y_channel = options.y_channel;
+  if (!options.save_frames.empty()) std::filesystem::create_directories(options.save_frames);
+
+  const auto frames = pick_frames(data, options);
+  Progress progress("eval " + result.name, static_cast<int64_t>(frames.size()));
+  double psnr_sum = 0, ssim_sum = 0;
+  int psnr_count = 0;
+  // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
+  const auto upscale_frame = [&](const Batch& b, int frame) {
+    if (upscaler.uses_previous_frame() && frame > 0)
+      upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels));
+    return upscaler.upscale(b);
+  };
+  for (int frame : frames) {
+    const Batch b = frame_batch(data, frame, result.scale, channels);
+    const auto sr = upscale_frame(b, frame).clamp(0.0, 1.0);
+    const auto details = upscaler.frame_details();
+    if (!torch::isfinite(sr).all().item<bool>())
+      throw Error(result.name + ": frame " + std::to_string(frame), "the upscaler produced NaN or infinite values");
+    FrameScore score;
+    score.frame = frame;
+    score.details = details;
+    score.psnr = psnr(sr, b.hr_color, quality).item<double>();
+    score.ssim = ssim(sr, b.hr_color, quality).item<double>();
+    if (std::isinf(score.psnr)) {
+      ++result.identical_frames;
+    } else {
+      psnr_sum += score.psnr;
+      ++psnr_count;
+    }
+    ssim_sum += score.ssim;
+    if (temporal && frame > 0) {
+      const Batch prev = frame_batch(data, frame - 1, result.scale, channels);
+      const auto prev_sr = upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
+      const auto motion = hr_motion(b);
+      score.temporal_error = warping_error(sr, prev_sr, motion);
+      score.temporal_error_reference = warping_error(b.hr_color, prev.hr_color, motion);
+    }
+    if (!options.save_frames.empty()) {
+      char name[64];
+      std::snprintf(name, sizeof name, "frame%04d.png", frame);
+      write_image(std::filesystem::path(options.save_frames) / (result.name + "_" + name), sr[0]);
+    }
+    result.frames.push_back(score);
+    progress.advance();
+  }
+  progress.finish();
+  result.psnr = psnr_count ? psnr_sum / psnr_count : INFINITY;
+  result.ssim = ssim_sum / static_cast<double>(frames.size());
+  result.temporal_error = mean_of(result.frames, &FrameScore::temporal_error);
+  result.temporal_error_reference = mean_of(result.frames, &FrameScore::temporal_error_reference);
+
+  const Batch first = frame_batch(data, frames.front(), result.scale, upscaler.channels());
+  result.lr_width = first.lr_color.size(3);
+  result.lr_height = first.lr_color.size(2);
+  result.cost = upscaler.cost(result.lr_width, result.lr_height);
+  if (options.latency_runs > 0)
+    result.latency = measure_latency([&] { upscaler.upscale(first); }, /*warmup=*/2, options.latency_runs);
+  return result;
+}
+
+nlohmann::ordered_json to_json(const EvalResult& r) {
+  nlohmann::ordered_json j;
+  j["name"] = r.name;
+  j["dataset"] = r.dataset;
+  j["split"] = r.split;
+  j["scale"] = r.scale;
+  j["lr_width"] = r.lr_width;
+  j["lr_height"] = r.lr_height;
+  put_psnr(j, "psnr", r.psnr);
+  j["ssim"] = r.ssim;
+  j["identical_frames"] = r.identical_frames;
+  j["temporal_error"] = r.temporal_error ? nlohmann::ordered_json(*r.temporal_error) : nullptr;
+  j["temporal_error_reference"] =
+      r.temporal_error_reference ? nlohmann::ordered_json(*r.temporal_error_reference) : nullptr;
+  if (r.latency) {
+    j["latency_ms"] = {{"median", r.latency->median_ms}, {"min", r.latency->min_ms}, {"max", r.latency->max_ms},
+                       {"runs", r.latency->runs}};
+  } else {
+    j["latency_ms"] = nullptr;
+  }
+  if (r.cost) {
+    j["params"] = r.cost->params;
+    j["macs"] = r.cost->macs;
+  } else {
+    j["params"] = nullptr;
+    j["macs"] = nullptr;
+  }
+  j["frames"] = nlohmann::ordered_json::array();
+  for (const auto& f : r.frames) {
+    nlohmann::ordered_json fj;
+    fj["frame"] = f.frame;
+    put_psnr(fj, "psnr", f.psnr);
+    fj["ssim"] = f.ssim;
+    fj["temporal_error"] = f.temporal_error ? nlohmann::ordered_json(*f.temporal_error) : nullptr;
+    fj["temporal_error_reference"] =
+        f.temporal_error_reference ? nlohmann::ordered_json(*f.temporal_error_reference) : nullptr;
+    if (!f.details.is_null()) fj["details"] = f.details;
+    j["frames"].push_back(fj);
+  }
+  return j;
+}
+
+EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::string& context) {
+  try {
+    EvalResult r;
+    r.name = j.at("name");
+    r.dataset = j.at("dataset");
+    r.split = j.at("split");
+    r.scale = j.at("scale");
+    r.lr_width = j.at("lr_width");
+    r.lr_height = j.at("lr_height");
+    r.psnr = j.at("psnr").is_null() ? INFINITY : j.at("psnr").get<double>();
+    r.ssim = j.at("ssim");
+    r.identical_frames = j.value("identical_frames", 0);
+    if (!j.at("temporal_error").is_null()) r.temporal_error = j.at("temporal_error").get<double>();
+    if (!j.at("temporal_error_reference").is_null())
+      r.temporal_error_reference = j.at("temporal_error_reference").get<double>();
+    if (!j.at("latency_ms").is_null()) {
+      LatencyStats l;
+      l.median_ms = j["latency_ms"].at("median");
+      l.min_ms = j["latency_ms"].at("min");
+      l.max_ms = j["latency_ms"].at("max");
+      l.runs = j["latency_ms"].at("runs");
+      r.latency = l;
+    }
+    if (!j.at("params").is_null()) {
+      Complexity c;
+      c.params = j.at("params");
+      c.macs = j.at("macs");
+      c.lr_width = r.lr_width;
+      c.lr_height = r.lr_height;
+      r.cost = c;
+    }
+    for (const auto& f : j.at("frames")) {
+      FrameScore s;
+      s.frame = f.at("frame");
+      s.psnr = f.at("psnr").is_null() ? INFINITY : f.at("psnr").get<double>();
+      s.ssim = f.at("ssim");
+      if (!f.at("temporal_error").is_null()) s.temporal_error = f.at("temporal_error").get<double>();
+      if (!f.at("temporal_error_reference").is_null())
+        s.temporal_error_reference = f.at("temporal_error_reference").get<double>();
+      if (f.contains("details")) s.details = f["details"];
+      r.frames.push_back(s);
+    }
+    return r;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(context, std::string("not an evaluation result: ") + e.what());
+  }
+}
+
+std::string frames_csv(const EvalResult& r) {
+  std::ostringstream csv;
+  csv << "model,frame,psnr,ssim,temporal_error,temporal_error_reference\n";
+  for (const auto& f : r.frames) {
+    csv << r.name << "," << f.frame << "," << (std::isinf(f.psnr) ? std::string("inf") : std::to_string(f.psnr)) << ","
+        << f.ssim << "," << (f.temporal_error ? std::to_string(*f.temporal_error) : "") << ","
+        << (f.temporal_error_reference ? std::to_string(*f.temporal_error_reference) : "") << "\n";
+  }
+  return csv.str();
+}
+
+}  // namespace cgsr

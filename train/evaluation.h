@@ -1,0 +1,58 @@
+#pragma once
+// Evaluation of any upscaler on full frames of a data set split: per-frame PSNR/SSIM (README
+// convention), temporal stability (warping error between consecutive outputs using the rendered
+// motion vectors, next to the same figure for the ground truth), and latency at the frame size.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/metrics.h"
+#include "core/timing.h"
+#include "render_data/dataset.h"
+#include "train/upscaler.h"
+
+namespace cgsr {
+
+struct EvalOptions {
+  std::string split = "test";
+  int max_frames = 0;          // 0 = every frame of the split
+  int crop_border = 0;         // pixels (HR) ignored at each side
+  bool y_channel = false;      // PSNR/SSIM on BT.601 luma instead of RGB
+  bool temporal = true;        // needs motion vectors and the previous frame
+  int latency_runs = 10;       // timed runs (after 2 warm-up runs) on one frame; 0 = skip
+  std::string save_frames;     // directory for SR frames as PNG; "" = do not save
+};
+config::Schema<EvalOptions> eval_schema_fields();
+
+struct FrameScore {
+  int frame = 0;
+  double psnr = 0, ssim = 0;
+  std::optional<double> temporal_error, temporal_error_reference;  // none for the first frame
+  nlohmann::ordered_json details;  // Upscaler::frame_details() of this frame (null for most upscalers)
+};
+
+struct EvalResult {
+  std::string name;
+  std::string dataset;  // the data set's scene name
+  std::string split;
+  int scale = 2;
+  int64_t lr_width = 0, lr_height = 0;
+  std::vector<FrameScore> frames;
+  double psnr = 0, ssim = 0;  // means over frames (PSNR of identical frames excluded, counted)
+  int identical_frames = 0;
+  std::optional<double> temporal_error, temporal_error_reference;
+  std::optional<LatencyStats> latency;
+  std::optional<Complexity> cost;
+};
+
+EvalResult evaluate(Upscaler& upscaler, const Dataset& dataset, const EvalOptions& options);
+
+nlohmann::ordered_json to_json(const EvalResult& result);
+EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::string& context);
+std::string frames_csv(const EvalResult& result);
+
+}  // namespace cgsr

@@ -1,0 +1,131 @@
+#include "train/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/plot.h"
+
+namespace cgsr {
+namespace {
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+struct Cells {
+  std::string params, macs, latency, psnr, ssim, temporal;
+};
+
+Cells cells(const EvalResult& r) {
+  Cells c;
+  c.params = r.cost ? fixed(r.cost->params / 1000.0, 1) : "NA";
+  c.macs = r.cost ? fixed(r.cost->macs / 1e9, 2) : "NA";
+  c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
+  c.psnr = fixed(r.psnr, 2);
+  c.ssim = fixed(r.ssim, 4);
+  c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
+  return c;
+}
+}  // namespace
+
+std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
+  std::vector<ReportTable> tables;
+  for (const auto& r : results) {
+    auto it = std::find_if(tables.begin(), tables.end(),
+                           [&](const ReportTable& t) { return t.dataset == r.dataset && t.scale == r.scale; });
+    if (it == tables.end()) {
+      tables.push_back({r.dataset, r.scale, {}});
+      it = tables.end() - 1;
+    }
+    it->rows.push_back(r);
+  }
+  return tables;
+}
+
+std::vector<size_t> pareto_front(const ReportTable& table) {
+  std::vector<size_t> front;
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    const auto& a = table.rows[i];
+    if (!a.latency) continue;
+    bool dominated = false;
+    for (size_t j = 0; j < table.rows.size() && !dominated; ++j) {
+      const auto& b = table.rows[j];
+      if (i == j || !b.latency) continue;
+      const bool no_worse = b.latency->median_ms <= a.latency->median_ms && b.psnr >= a.psnr;
+      const bool better = b.latency->median_ms < a.latency->median_ms || b.psnr > a.psnr;
+      dominated = no_worse && better;
+    }
+    if (!dominated) front.push_back(i);
+  }
+  return front;
+}
+
+std::string report_markdown(const ReportTable& table) {
+  std::ostringstream md;
+  const auto& first = table.rows.front();
+  md << "### " << table.dataset << " x" << table.scale << " (" << first.split << " split, " << first.frames.size()
+     << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
+  md << "| Model | Params (k) | MACs (G) | Latency (ms) | PSNR (dB) | SSIM | Temporal error (x1e-3) |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|\n";
+  const auto front = pareto_front(table);
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    const auto& r = table.rows[i];
+    const auto c = cells(r);
+    const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+    md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | " << c.latency
+       << " | " << c.psnr << " | " << c.ssim << " | " << c.temporal << " |\n";
+  }
+  if (first.temporal_error_reference)
+    md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
+       << "e-3. ";
+  md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
+        "of repeated runs on this machine.\n";
+  return md.str();
+}
+
+std::string report_csv(const std::vector<ReportTable>& tables) {
+  std::ostringstream csv;
+  csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames\n";
+  for (const auto& t : tables)
+    for (const auto& r : t.rows) {
+      csv << t.dataset << "," << t.scale << "," << r.name << "," << (r.cost ? std::to_string(r.cost->params) : "")
+          << "," << (r.cost ? std::to_string(r.cost->macs) : "") << ","
+          << (r.latency ? fixed(r.latency->median_ms, 4) : "") << "," << fixed(r.psnr, 4) << "," << fixed(r.ssim, 6)
+          << "," << (r.temporal_error ? fixed(*r.temporal_error, 6) : "") << ","
+          << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size()
+          << "\n";
+    }
+  return csv.str();
+}
+
+void write_report_plot(const std::filesystem::path& path, const ReportTable& table) {
+  ScatterPlot plot;
+  plot.title = table.dataset + " x" + std::to_string(table.scale) + ": PSNR against latency";
+  plot.x_label = "latency (ms, median, log scale)";
+  plot.y_label = "PSNR (dB)";
+  plot.log_x = true;
+  const auto front = pareto_front(table);
+  PlotSeries others{"upscaler", {40, 90, 180}, 5, false, {}}, best{"Pareto front", {220, 40, 40}, 6, true, {}};
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    const auto& r = table.rows[i];
+    const std::string label = std::to_string(i + 1);
+    plot.notes.push_back(label + ". " + r.name + " " + fixed(r.psnr, 2) + " dB");
+    if (!r.latency) {
+      plot.horizontal_lines.emplace_back(r.psnr, r.name + " (no latency)");
+      continue;
+    }
+    const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+    (on_front ? best : others).points.push_back({r.latency->median_ms, r.psnr, label});
+  }
+  plot.series = {others, best};
+  write_scatter_plot(path, plot);
+}
+
+}  // namespace cgsr

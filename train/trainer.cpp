@@ -1,0 +1,329 @@
+#include "train/trainer.h"
+
+#include <spdlog/spdlog.h>
+#include <torch/torch.h>
+
+#include <cmath>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/metrics.h"
+#include "core/progress.h"
+#include "models/arch_spec.h"
+#include "render_data/patch_sampler.h"
+
+namespace cgsr {
+
+config::Schema<TrainSchedule> schedule_schema() {
+  config::Schema<TrainSchedule> s;
+  s.field("steps", &TrainSchedule::steps, "optimizer steps").range(1, 10'000'000);
+  s.field("batch_size", &TrainSchedule::batch_size, "patches per step").range(1, 1024);
+  s.field("patch_size", &TrainSchedule::patch_size, "LR patch side in pixels").range(4, 1024);
+  s.field("lr_max", &TrainSchedule::lr_max, "learning rate at the start of the cosine schedule").range(1e-12, 100);
+  s.field("lr_min", &TrainSchedule::lr_min, "learning rate at the end of the cosine schedule").range(0, 100);
+  s.field("clip_grad_norm", &TrainSchedule::clip_grad_norm, "gradient norm limit (0 = no clipping)").at_least(0);
+  s.field("augment", &TrainSchedule::augment, "random flips and 90 degree rotations");
+  s.field("validate_every", &TrainSchedule::validate_every, "steps between validations (0 = at the end)").at_least(0);
+  s.field("val_frames", &TrainSchedule::val_frames, "validation frames (0 = the whole split)").at_least(0);
+  s.field("checkpoint_every", &TrainSchedule::checkpoint_every, "steps between checkpoints").at_least(1);
+  s.field("max_nonfinite_steps", &TrainSchedule::max_nonfinite_steps,
+          "consecutive steps with a non-finite loss or gradient before training stops")
+      .at_least(1);
+  s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
+    if (t.lr_min > t.lr_max) at.child("lr_min").fail(node["lr_min"] ? node["lr_min"] : node, "must not exceed lr_max");
+  });
+  return s;
+}
+
+nlohmann::ordered_json to_json(const TrainOutcome& o) {
+  auto score = [](const ValidationScore& s) {
+    nlohmann::ordered_json j;
+    j["step"] = s.step;
+    put_psnr(j, "psnr", s.psnr);
+    j["ssim"] = s.ssim;
+    j["image_loss"] = s.image_loss;
+    j["geometry_loss"] = s.geometry_loss;
+    return j;
+  };
+  nlohmann::ordered_json j;
+  j["steps"] = o.steps;
+  j["skipped_steps"] = o.skipped_steps;
+  j["seconds"] = o.seconds;
+  j["patches_per_second"] = o.patches_per_second;
+  j["resumed"] = o.resumed;
+  j["best"] = score(o.best);
+  j["last"] = score(o.last);
+  j["history"] = nlohmann::ordered_json::array();
+  for (const auto& s : o.history) j["history"].push_back(score(s));
+  return j;
+}
+
+namespace {
+std::vector<torch::Tensor> trainable(const SRNetworkImpl& net) {
+  std::vector<torch::Tensor> out;
+  for (const auto& p : net.parameters())
+    if (p.requires_grad()) out.push_back(p);
+  return out;
+}
+
+std::vector<torch::Tensor> snapshot(const std::vector<torch::Tensor>& params) {
+  std::vector<torch::Tensor> out;
+  for (const auto& p : params) out.push_back(p.detach().clone());
+  return out;
+}
+
+void restore(const std::vector<torch::Tensor>& params, const std::vector<torch::Tensor>& weights) {
+  torch::NoGradGuard no_grad;
+  CGSR_CHECK(params.size() == weights.size(), "weight snapshot does not match the network");
+  for (size_t i = 0; i < params.size(); ++i) params[i].copy_(weights[i]);
+}
+
+torch::Tensor text_tensor(const std::string& text) {
+  return torch::from_blob(const_cast<char*>(text.data()), {static_cast<int64_t>(text.size())}, torch::kUInt8).clone();
+}
+std::string tensor_text(const torch::Tensor& t) {
+  const auto c = t.contiguous();
+  return std::string(reinterpret_cast<const char*>(c.data_ptr<uint8_t>()), static_cast<size_t>(c.numel()));
+}
+
+// Frames spread evenly over `frames`, at most `count` (0 = all).
+std::vector<int> spread(const std::vector<int>& frames, int count) {
+  if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
+  std::vector<int> out;
+  for (int i = 0; i < count; ++i) out.push_back(frames[i * frames.size() / count]);
+  return out;
+}
+}  // namespace
+
+Trainer::Trainer(SRNetwork network, const Dataset& data, TrainSchedule schedule, LossOptions loss, ShrinkTargets shrink,
+                 TrainHooks hooks)
+    : network_(std::move(network)),
+      data_(data),
+      schedule_(schedule),
+      loss_(std::move(loss)),
+      shrink_(std::move(shrink)),
+      hooks_(std::move(hooks)),
+      channels_(network_->input_channels()) {
+  val_frames_ = spread(data_.frames(Split::Val), schedule_.val_frames);
+  if (val_frames_.empty()) val_frames_ = spread(data_.frames(Split::Train), std::max(1, schedule_.val_frames));
+  if (data_.frames(Split::Train).empty())
+    throw Error(data_.info().root.string(), "the data set has no training frames");
+}
+
+std::vector<torch::Tensor> Trainer::tracked() const {
+  auto out = network_->parameters();
+  out.insert(out.end(), hooks_.extra_parameters.begin(), hooks_.extra_parameters.end());
+  return out;
+}
+
+TrainOutput Trainer::forward(const Batch& batch, int step) {
+  if (hooks_.forward) return hooks_.forward(batch, step);
+  return network_->forward_train(batch.lr_color, network_->info_input(batch));
+}
+
+double Trainer::learning_rate(int step) const {
+  const double t = static_cast<double>(step) / std::max(1, schedule_.steps);
+  return schedule_.lr_min + 0.5 * (schedule_.lr_max - schedule_.lr_min) * (1.0 + std::cos(M_PI * t));
+}
+
+ValidationScore Trainer::validate(int step) {
+  torch::NoGradGuard no_grad;
+  network_->eval();
+  ValidationScore score;
+  score.step = step;
+  for (int frame : val_frames_) {
+    const Batch b = frame_batch(data_, frame, network_->spec().scale, channels_);
+    const auto out = forward(b, step);
+    const auto image = out.image.clamp(0.0, 1.0);
+    score.psnr += psnr(image, b.hr_color).item<double>();
+    score.ssim += ssim(image, b.hr_color).item<double>();
+    score.image_loss += reconstruction_error(out.image, b.hr_color, loss_.image_norm).item<double>();
+    if (out.geometry.defined())
+      score.geometry_loss +=
+          reconstruction_error(out.geometry, network_->geometry_target(b), loss_.geometry_norm).item<double>();
+  }
+  const double n = static_cast<double>(val_frames_.size());
+  score.psnr /= n;
+  score.ssim /= n;
+  score.image_loss /= n;
+  score.geometry_loss /= n;
+  network_->train();
+  return score;
+}
+
+void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome) {
+  torch::serialize::OutputArchive archive;
+  torch::serialize::OutputArchive model, optimizer, best;
+  network_->save(model);
+  optimizer_->save(optimizer);
+  for (size_t i = 0; i < best_weights_.size(); ++i) best.write(std::to_string(i), best_weights_[i]);
+  torch::serialize::OutputArchive extra;
+  for (size_t i = 0; i < hooks_.extra_parameters.size(); ++i)
+    extra.write(std::to_string(i), hooks_.extra_parameters[i]);
+  archive.write("extra", extra);
+  archive.write("model", model);
+  archive.write("optimizer", optimizer);
+  archive.write("best", best);
+  archive.write("step", torch::tensor(static_cast<int64_t>(step)));
+  archive.write("spec", text_tensor(spec_to_yaml(network_->spec())));
+  archive.write("outcome", text_tensor(to_json(outcome).dump()));
+  archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
+  write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
+}
+
+bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, TrainOutcome& outcome) {
+  if (!std::filesystem::exists(path)) return false;
+  try {
+    torch::serialize::InputArchive archive, model, optimizer, best;
+    archive.load_from(path.string());
+    torch::Tensor spec, step_t, outcome_t, rng;
+    archive.read("spec", spec);
+    if (tensor_text(spec) != spec_to_yaml(network_->spec()))
+      throw Error(path.string(), "the checkpoint was written for a different architecture:\n" + tensor_text(spec));
+    archive.read("model", model);
+    network_->load(model);
+    if (!hooks_.extra_parameters.empty()) {
+      torch::serialize::InputArchive extra;
+      archive.read("extra", extra);
+      torch::NoGradGuard no_grad;
+      for (size_t i = 0; i < hooks_.extra_parameters.size(); ++i) {
+        torch::Tensor t;
+        extra.read(std::to_string(i), t);
+        if (t.sizes() != hooks_.extra_parameters[i].sizes())
+          throw Error(path.string(), "the checkpoint's extra training parameters do not match");
+        hooks_.extra_parameters[i].copy_(t);
+      }
+    }
+    archive.read("optimizer", optimizer);
+    optimizer_->load(optimizer);
+    archive.read("best", best);
+    best_weights_.clear();
+    for (size_t i = 0; i < tracked().size(); ++i) {
+      torch::Tensor w;
+      if (!best.try_read(std::to_string(i), w)) break;
+      best_weights_.push_back(w);
+    }
+    archive.read("step", step_t);
+    step = static_cast<int>(step_t.item<int64_t>());
+    archive.read("outcome", outcome_t);
+    const auto j = nlohmann::json::parse(tensor_text(outcome_t));
+    outcome.skipped_steps = j["skipped_steps"];
+    auto score = [](const nlohmann::json& s) {
+      ValidationScore v;
+      v.step = s["step"];
+      v.psnr = s["psnr"].is_null() ? INFINITY : s["psnr"].get<double>();
+      v.ssim = s["ssim"];
+      v.image_loss = s["image_loss"];
+      v.geometry_loss = s["geometry_loss"];
+      return v;
+    };
+    outcome.best = score(j["best"]);
+    outcome.last = score(j["last"]);
+    for (const auto& s : j["history"]) outcome.history.push_back(score(s));
+    archive.read("torch_rng", rng);
+    at::Generator generator = at::detail::getDefaultCPUGenerator();  // a handle to the global generator
+    generator.set_state(rng);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(path.string(), std::string("unreadable checkpoint: ") + e.what());
+  }
+  if (step > schedule_.steps)
+    throw Error(path.string(), "the checkpoint is at step " + std::to_string(step) + ", beyond the schedule's " +
+                                   std::to_string(schedule_.steps) + " steps");
+  return true;
+}
+
+TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint, bool resume) {
+  auto params = trainable(*network_);
+  for (const auto& p : hooks_.extra_parameters)
+    if (p.requires_grad()) params.push_back(p);
+  optimizer_ = std::make_unique<torch::optim::Adam>(params, torch::optim::AdamOptions(schedule_.lr_max));
+  TrainOutcome outcome;
+  int step = 0;
+  if (checkpoint && resume && load_checkpoint(*checkpoint, step, outcome)) {
+    outcome.resumed = true;
+    spdlog::info("resuming from {} at step {}/{}", checkpoint->string(), step, schedule_.steps);
+  }
+
+  PatchSamplerOptions sampling;
+  sampling.scale = network_->spec().scale;
+  sampling.patch_size = schedule_.patch_size;
+  sampling.batch_size = schedule_.batch_size;
+  sampling.split = Split::Train;
+  sampling.channels = channels_;
+  sampling.augment = schedule_.augment;
+  PatchSampler sampler(data_, sampling);
+
+  network_->train();
+  Progress progress("train", schedule_.steps, step);
+  int consecutive_bad = 0;
+  const auto started = std::chrono::steady_clock::now();
+  const int first_step = step;
+  while (step < schedule_.steps) {
+    const double lr = learning_rate(step);
+    for (auto& group : optimizer_->param_groups())
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+
+    // Batches are a function of the step, so a resumed run sees the same data.
+    const Batch batch = sampler.batch(step);
+    const auto output = forward(batch, step);
+    LossTerms terms = cgsr_loss(*network_, output, batch, loss_, shrink_);
+    if (hooks_.extra_loss) terms.total = terms.total + hooks_.extra_loss(batch, output, step);
+    optimizer_->zero_grad();
+    bool finite = std::isfinite(terms.total.item<double>());
+    if (finite) {
+      terms.total.backward();
+      const double limit = schedule_.clip_grad_norm > 0 ? schedule_.clip_grad_norm : INFINITY;
+      finite = std::isfinite(torch::nn::utils::clip_grad_norm_(params, limit));
+    }
+    if (finite) {
+      optimizer_->step();
+      consecutive_bad = 0;
+    } else {
+      optimizer_->zero_grad();
+      ++outcome.skipped_steps;
+      spdlog::warn("step {}: non-finite loss or gradient (lr {:.3g}); step skipped", step, lr);
+      if (++consecutive_bad >= schedule_.max_nonfinite_steps)
+        throw Error("train", std::to_string(consecutive_bad) + " consecutive steps with a non-finite loss or gradient "
+                             "at step " + std::to_string(step) + " (learning rate " + std::to_string(lr) +
+                             "); lower schedule.lr_max or raise clip_grad_norm");
+    }
+    ++step;
+    progress.set_status("loss " + std::to_string(terms.image).substr(0, 8) + " lr " + std::to_string(lr).substr(0, 8));
+    progress.advance();
+
+    const bool last = step == schedule_.steps;
+    if ((schedule_.validate_every > 0 && step % schedule_.validate_every == 0) || last) {
+      const ValidationScore score = validate(step);
+      outcome.history.push_back(score);
+      outcome.last = score;
+      if (best_weights_.empty() || score.psnr > outcome.best.psnr) {
+        outcome.best = score;
+        best_weights_ = snapshot(tracked());
+      }
+      spdlog::info("step {}: validation PSNR {:.3f} dB, SSIM {:.4f} (best {:.3f} at step {})", step, score.psnr,
+                   score.ssim, outcome.best.psnr, outcome.best.step);
+    }
+    if (checkpoint && (step % schedule_.checkpoint_every == 0 || last)) save_checkpoint(*checkpoint, step, outcome);
+  }
+  progress.finish();
+  outcome.steps = step;
+  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  outcome.patches_per_second =
+      outcome.seconds > 0 ? (step - first_step) * static_cast<double>(schedule_.batch_size) / outcome.seconds : 0;
+  last_weights_ = snapshot(tracked());
+  if (!best_weights_.empty()) restore(tracked(), best_weights_);
+  network_->eval();
+  return outcome;
+}
+
+void Trainer::save_last_model(const std::filesystem::path& path, const Provenance& provenance) const {
+  CGSR_CHECK(!last_weights_.empty(), "save_last_model() before run()");
+  const auto best = snapshot(tracked());
+  restore(tracked(), last_weights_);
+  save_model(path, *network_, provenance);
+  restore(tracked(), best);
+}
+
+}  // namespace cgsr

@@ -1,0 +1,108 @@
+#pragma once
+// Training of a network on patches of a data set: Adam with cosine annealing, the CGSR loss,
+// gradient-norm clipping, a guard against non-finite steps, validation on full frames, best and
+// last weights, and checkpoints that resume the same schedule exactly (weights, optimizer state,
+// step, RNG state). Used by `cgsr train` and, through the search command, for search candidates.
+
+#include <torch/optim/adam.h>
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "models/model_file.h"
+#include "models/sr_network.h"
+#include "render_data/dataset.h"
+#include "train/losses.h"
+
+namespace cgsr {
+
+struct TrainSchedule {
+  int steps = 2000;
+  int batch_size = 16;
+  int patch_size = 48;  // LR pixels; HR patches are scale x larger
+  double lr_max = 1e-3;
+  double lr_min = 1e-6;
+  double clip_grad_norm = 1.0;  // 0 disables clipping
+  bool augment = true;          // flips and 90 degree rotations
+  int validate_every = 250;     // steps; 0 = only at the end
+  int val_frames = 8;           // validation frames (spread over the split); 0 = all
+  int checkpoint_every = 100;   // steps
+  int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
+};
+config::Schema<TrainSchedule> schedule_schema();
+
+struct ValidationScore {
+  int step = 0;
+  double psnr = 0, ssim = 0;
+  double image_loss = 0, geometry_loss = 0;  // the joint loss terms on full frames
+};
+
+struct TrainOutcome {
+  int steps = 0;
+  int skipped_steps = 0;
+  double seconds = 0;
+  double patches_per_second = 0;
+  ValidationScore best, last;
+  std::vector<ValidationScore> history;
+  bool resumed = false;
+};
+nlohmann::ordered_json to_json(const TrainOutcome& outcome);
+
+// Optional changes to the training step for stages that train more than the plain network
+// (pruning: per-sample channel patterns chosen by dynamic pruning components, an extra penalty
+// and the components' own parameters). Empty members keep the default behaviour.
+struct TrainHooks {
+  // Replaces network->forward_train(lr_color, info_input) in training steps and validation
+  // (validation runs it in eval mode without autograd). `step` is the optimizer step.
+  std::function<TrainOutput(const Batch& batch, int step)> forward;
+  // Added to the CGSR loss of every training step: a differentiable scalar.
+  std::function<torch::Tensor(const Batch& batch, const TrainOutput& output, int step)> extra_loss;
+  // Optimized with the network's parameters, saved in checkpoints and restored with the best
+  // validation weights.
+  std::vector<torch::Tensor> extra_parameters;
+};
+
+class Trainer {
+ public:
+  Trainer(SRNetwork network, const Dataset& data, TrainSchedule schedule, LossOptions loss,
+          ShrinkTargets shrink = {}, TrainHooks hooks = {});
+
+  // Trains to the end of the schedule. With `checkpoint`, state is saved there every
+  // checkpoint_every steps (atomically) and, when `resume` is set and the file exists, training
+  // continues from it. Afterwards the network holds the best validation weights.
+  TrainOutcome run(const std::optional<std::filesystem::path>& checkpoint = std::nullopt, bool resume = false);
+
+  // PSNR/SSIM and loss terms on the validation frames.
+  ValidationScore validate(int step);
+
+  SRNetwork network() const { return network_; }
+
+  // Writes the weights of the final step (the network itself holds the best ones after run()).
+  void save_last_model(const std::filesystem::path& path, const Provenance& provenance) const;
+
+ private:
+  double learning_rate(int step) const;
+  TrainOutput forward(const Batch& batch, int step);
+  std::vector<torch::Tensor> tracked() const;  // the network's parameters, then the hooks' extras
+  void save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome);
+  bool load_checkpoint(const std::filesystem::path& path, int& step, TrainOutcome& outcome);
+
+  SRNetwork network_;
+  const Dataset& data_;
+  TrainSchedule schedule_;
+  LossOptions loss_;
+  ShrinkTargets shrink_;
+  TrainHooks hooks_;
+  std::vector<RenderChannel> channels_;
+  std::vector<int> val_frames_;
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  std::vector<torch::Tensor> best_weights_, last_weights_;
+};
+
+}  // namespace cgsr
