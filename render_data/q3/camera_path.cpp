@@ -300,24 +300,47 @@ Vec3 point_at(const std::vector<Vec3>& line, const std::vector<double>& cum, dou
   return lerp(line[i - 1], line[i], seg > 0 ? static_cast<float>((s - cum[i - 1]) / seg) : 0.0f);
 }
 
-// A player looks where there is room to look: the heading turned by up to +-`search` degrees
-// (in 15-degree steps) towards the longest free line of sight, favouring small turns.
-Vec3 turn_towards_open_space(const BspCollision& collision, Vec3 eye, Vec3 look, float search) {
-  if (search <= 0) return look;
-  const float horizontal = std::hypot(look.x, look.y);
-  if (horizontal < 1e-3f) return look;
-  const float yaw = std::atan2(look.y, look.x);
-  constexpr float kRange = 2048;
-  float best_score = -1, best_turn = 0;
-  for (float turn = -search; turn <= search + 1e-3f; turn += 15.0f) {
-    const float a = yaw + turn / kDeg;
-    const Vec3 ray{std::cos(a) * horizontal, std::sin(a) * horizontal, look.z};
-    const float free = collision.trace(eye, eye + ray * kRange, Vec3{}).fraction * kRange;
-    const float score = std::min(free, 1024.0f) * (0.5f + 0.5f * std::cos(turn / kDeg));
-    if (score > best_score) best_score = score, best_turn = turn;
+// A player looks where there is room to look: at each key the heading may turn by up to
+// +-`search` degrees (15-degree steps) towards a longer horizontal line of sight. The turns are
+// chosen jointly along the path (dynamic programming: long sight lines and small turns are
+// rewarded, changing the turn between neighbouring keys costs), so the view does not flicker
+// between two openings. Returns the turn per key, degrees.
+std::vector<float> open_space_turns(const BspCollision& collision, const std::vector<Vec3>& eyes,
+                                    const std::vector<float>& yaw_degrees, float search) {
+  const size_t n = eyes.size();
+  std::vector<float> candidates;
+  for (float t = -std::floor(search / 15) * 15; t <= search + 1e-3f; t += 15) candidates.push_back(t);
+  if (candidates.size() <= 1) return std::vector<float>(n, 0.0f);
+  const size_t m = candidates.size();
+  constexpr float kRange = 2048, kSwitchCost = 0.5f;
+  std::vector<float> cost(m), next(m);
+  std::vector<std::vector<uint8_t>> from(n, std::vector<uint8_t>(m, 0));
+  for (size_t k = 0; k < n; ++k) {
+    for (size_t i = 0; i < m; ++i) {
+      const float a = (yaw_degrees[k] + candidates[i]) / kDeg;
+      const Vec3 ray{std::cos(a) * kRange, std::sin(a) * kRange, 0};
+      const float sight = std::clamp(collision.trace(eyes[k], eyes[k] + ray, Vec3{}).fraction * kRange, 8.0f, 1024.0f);
+      const float local = -std::log(sight) - std::log(0.5f + 0.5f * std::cos(candidates[i] / kDeg));
+      if (k == 0) {
+        next[i] = local;
+        continue;
+      }
+      float best = std::numeric_limits<float>::infinity();
+      for (size_t j = 0; j < m; ++j) {
+        const float c = cost[j] + kSwitchCost * std::fabs(candidates[i] - candidates[j]) / 15.0f;
+        if (c < best) best = c, from[k][i] = static_cast<uint8_t>(j);
+      }
+      next[i] = best + local;
+    }
+    cost = next;
   }
-  const float a = yaw + best_turn / kDeg;
-  return {std::cos(a) * horizontal, std::sin(a) * horizontal, look.z};
+  std::vector<float> turns(n);
+  size_t at = std::min_element(cost.begin(), cost.end()) - cost.begin();
+  for (size_t k = n; k-- > 0;) {
+    turns[k] = candidates[at];
+    at = from[k][at];
+  }
+  return turns;
 }
 
 }  // namespace
@@ -406,23 +429,34 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
     positions[k] = point_at(line, cum, k * spacing);
     const Vec3 ahead = point_at(line, cum, k * spacing + o.look_ahead) - positions[k];
     if (length(ahead) >= 1.0f) last_direction = normalize(ahead);
-    looks[k] = turn_towards_open_space(collision, positions[k], last_direction, o.open_space_degrees);
+    looks[k] = last_direction;
   }
   // Heading: the look directions averaged over +-look_ahead (Gaussian), so corners are anticipated
   // and left gradually.
   const int radius = std::max(1, static_cast<int>(std::lround(o.look_ahead / spacing)));
   std::vector<float> weights(2 * radius + 1);
   for (int j = -radius; j <= radius; ++j) weights[j + radius] = std::exp(-2.0f * j * j / float(radius * radius));
+  std::vector<float> heading_yaw(keys), heading_pitch(keys);
+  for (int k = 0; k < keys; ++k) {
+    Vec3 heading{};
+    for (int j = -radius; j <= radius; ++j) heading += looks[std::clamp(k + j, 0, keys - 1)] * weights[j + radius];
+    if (length(heading) < 1e-3f) heading = looks[k];
+    heading_yaw[k] = std::atan2(heading.y, heading.x) * kDeg;
+    heading_pitch[k] = std::atan2(heading.z, std::hypot(heading.x, heading.y)) * kDeg;
+  }
+  // Turned towards open space, coherently along the path, then smoothed like the heading.
+  const std::vector<float> turns = open_space_turns(collision, positions, heading_yaw, o.open_space_degrees);
   // Turn-rate limits, degrees per key: a reversal (a dead end) becomes a turn, not a jump.
   const float max_yaw_step = o.max_turn_rate * static_cast<float>(spacing);
   const float max_pitch_step = 0.5f * max_yaw_step;
   float yaw = 0, pitch = 0;
   for (int k = 0; k < keys; ++k) {
-    Vec3 heading{};
-    for (int j = -radius; j <= radius; ++j) heading += looks[std::clamp(k + j, 0, keys - 1)] * weights[j + radius];
-    if (length(heading) < 1e-3f) heading = looks[k];
-    const float target_yaw = std::atan2(heading.y, heading.x) * kDeg;
-    const float target_pitch = std::atan2(heading.z, std::hypot(heading.x, heading.y)) * kDeg;
+    float turn = 0, weight = 0;
+    for (int j = -radius; j <= radius; ++j) {
+      turn += turns[std::clamp(k + j, 0, keys - 1)] * weights[j + radius];
+      weight += weights[j + radius];
+    }
+    const float target_yaw = heading_yaw[k] + turn / weight, target_pitch = heading_pitch[k];
     if (k == 0) {
       yaw = target_yaw;
       pitch = target_pitch;
