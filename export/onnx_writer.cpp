@@ -66,9 +66,8 @@ class Writer {
       names_[op.output] = out;
       emit(op, out);
     }
-    if (names_[output_value] != kExportOutput) {  // the output is a graph input: nothing computes it
-      node("Identity", op_context("output"), {names_[output_value]}, {claim(kExportOutput)});
-    }
+    if (names_[output_value] != kExportOutput)  // the output is a graph input: nothing computes it
+      node("Identity", std::string(kExportOutput) + ".identity", {names_[output_value]}, {claim(kExportOutput)});
     declare(g_->add_output(), signature_.output);
     return std::move(model_);
   }

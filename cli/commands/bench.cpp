@@ -231,10 +231,10 @@ nlohmann::ordered_json run_bench(const BenchOptions& options) {
   }
   std::printf("input %s x%d, %d threads, %d warm-up + %d timed runs\n", options.input.c_str(), options.batch,
               thread_count(), options.warmup, options.runs);
-  std::printf("%-40s %-9s %-12s %10s %9s %9s %9s %9s\n", "model", "runtime", "detail", "median ms", "min ms", "max ms",
+  std::printf("%-40s %-11s %-12s %10s %9s %9s %9s %9s\n", "model", "runtime", "detail", "median ms", "min ms", "max ms",
               "GFLOP/s", "MACs");
   for (const auto& r : timed)
-    std::printf("%-40s %-9s %-12s %10.2f %9.2f %9.2f %9.1f %9s\n", r.target.name.c_str(), r.target.runtime.c_str(),
+    std::printf("%-40s %-11s %-12s %10.2f %9.2f %9.2f %9.1f %9s\n", r.target.name.c_str(), r.target.runtime.c_str(),
                 r.target.detail.c_str(), r.latency.median_ms, r.latency.min_ms, r.latency.max_ms, r.gflops,
                 format_count(static_cast<double>(r.target.macs)).c_str());
   if (results.contains("onnxruntime_vs_libtorch"))
