@@ -61,22 +61,23 @@ torch::Tensor remove_grid_lines(const torch::Tensor& edge, const GridLines& line
   if (lines.col_period > 0) grid.slice(1, lines.col_offset, W, lines.col_period).fill_(true);
   const auto on = e.gt(0) & ~grid;
   auto zero = torch::zeros({}, e.options());
-  // A pixel on a grid line stays when edges continue on both sides of the line: a real edge
-  // crossing it.
+  // A pixel on a grid line stays when a real edge crosses the line there.
   auto clear = [&](int dim, int period, int offset) {
     const int64_t n = dim == 0 ? H : W;
     for (int64_t i = offset; i < n; i += period) {
       auto line = e.select(dim, i);
-      // Neighbours across the line, widened by one pixel along it so diagonal edges count too.
-      auto widen = [](torch::Tensor t) {
-        auto w = t.clone();
-        w.slice(0, 1).logical_or_(t.slice(0, 0, -1));
-        w.slice(0, 0, -1).logical_or_(t.slice(0, 1));
-        return w;
-      };
-      const auto before = i > 0 ? widen(on.select(dim, i - 1)) : torch::zeros_like(line, torch::kBool);
-      const auto after = i + 1 < n ? widen(on.select(dim, i + 1)) : torch::zeros_like(line, torch::kBool);
-      line.copy_(torch::where(before & after, line, zero));
+      // A real edge continues through the line straight or diagonally: before[j] & after[j],
+      // before[j-1] & after[j+1] or before[j+1] & after[j-1].
+      const auto none = torch::zeros_like(line, torch::kBool);
+      const auto before = i > 0 ? on.select(dim, i - 1) : none;
+      const auto after = i + 1 < n ? on.select(dim, i + 1) : none;
+      auto keep = before & after;
+      const int64_t m = line.size(0);
+      if (m > 2) {
+        keep.slice(0, 1, m - 1).logical_or_(before.slice(0, 0, m - 2) & after.slice(0, 2, m));
+        keep.slice(0, 1, m - 1).logical_or_(before.slice(0, 2, m) & after.slice(0, 0, m - 2));
+      }
+      line.copy_(torch::where(keep, line, zero));
     }
   };
   if (lines.row_period > 0) clear(0, lines.row_period, lines.row_offset);

@@ -6,8 +6,8 @@
 // compared over every period p in [4, size/3] and offset o; the grid is the (smallest) (p, o)
 // whose rows are dense (mean density >= min_line_density) and anomalously denser than the
 // other rows (>= contrast x their mean + 0.1), found in at least 3 lines. Clean-up clears the
-// grid lines except where a genuine edge crosses them (edge pixels on both sides of the line,
-// directly or diagonally adjacent).
+// grid lines except where a genuine edge crosses them: edge pixels (off the grid) on both sides
+// of the line, straight across or diagonally opposite.
 
 #include <torch/types.h>
 

@@ -666,7 +666,7 @@ config::Schema<ProceduralOptions> procedural_schema() {
       .range(3, 200)
       .check([](const std::vector<int>& v) { return v.size() == 2; }, "must be [cells_x, cells_z]");
   s.field("cell", &ProceduralOptions::cell, "cell size, metres").range(1.0, 20.0);
-  s.field("height", &ProceduralOptions::height, "wall height, metres").range(2.5, 50.0);
+  s.field("height", &ProceduralOptions::height, "wall height, metres (arena: boundary height)").range(1.0, 50.0);
   s.field("ceiling", &ProceduralOptions::ceiling, "closed ceiling (rooms and corridors)");
   s.field("texture_size", &ProceduralOptions::texture_size, "texels per side of each texture").range(16, 2048);
   s.field("texel_density", &ProceduralOptions::texel_density, "texels per metre on walls and floors").range(1, 10000);
@@ -677,6 +677,10 @@ config::Schema<ProceduralOptions> procedural_schema() {
   auto rgb = [](const std::vector<float>& v) { return v.size() == 3; };
   s.field("sky_horizon", &ProceduralOptions::sky_horizon, "sky colour at the horizon, linear RGB").range(0, 10).check(rgb, "must be [r, g, b]");
   s.field("sky_zenith", &ProceduralOptions::sky_zenith, "sky colour overhead, linear RGB").range(0, 10).check(rgb, "must be [r, g, b]");
+  s.validate([](const ProceduralOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (o.layout != "arena" && o.height < o.camera.eye_height + 0.8f)
+      at.child("height").fail(node, "rooms and corridors need walls at least 0.8 m above the camera's eye height");
+  });
   return s;
 }
 

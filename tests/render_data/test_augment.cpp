@@ -5,6 +5,7 @@
 
 #include "render_data/augment.h"
 #include "render_data/derive_channels.h"
+#include "render_data/vec_math.h"
 
 namespace cgsr {
 namespace {

@@ -84,7 +84,9 @@ TEST(CgsrReleaseLoader, GridCleanupRemovesTheLinesAndKeepsTheBox) {
   EXPECT_EQ(e[4].sum().item<int64_t>(), 0);
   EXPECT_EQ(e.select(1, 4).sum().item<int64_t>(), 0);
   // The box outline (rows 24..63, columns 36..83 at 128 wide) is intact off the grid lines.
-  EXPECT_EQ(e[24].slice(0, 36, 84).sum().item<int64_t>(), 48 - 6);  // minus the 6 grid columns it crosses
+  // Its top edge crosses grid columns 44..76 (kept: a real crossing); only the corner at grid
+  // column 36, with nothing to its left, goes.
+  EXPECT_EQ(e[24].slice(0, 36, 84).sum().item<int64_t>(), 47);
   EXPECT_EQ(e[40][83].item<uint8_t>(), 1);  // the right side, off the grid columns
   // And the clean-up is reported.
   EXPECT_FALSE(data.info().notes.empty());

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "render_data/derive_channels.h"
+#include "render_data/vec_math.h"
 
 namespace cgsr {
 namespace {

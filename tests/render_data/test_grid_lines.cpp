@@ -24,23 +24,28 @@ TEST(GridLines, FindsAndRemovesPeriodicLines) {
   const auto truth = object_edges(H, W);
   auto noisy = truth.clone();
   for (int i = 3; i < H; i += 16) noisy[0][i].fill_(1);     // rows 3, 19, 35, 51
-  for (int j = 7; j < W; j += 16) noisy[0].select(1, j).fill_(1);  // cols 7, 23, 39, 55, 71
+  for (int j = 11; j < W; j += 16) noisy[0].select(1, j).fill_(1);  // cols 11, 27, 43, 59, 75
   const GridLines g = detect_grid_lines(noisy);
   EXPECT_EQ(g.row_period, 16);
   EXPECT_EQ(g.row_offset, 3);
   EXPECT_EQ(g.col_period, 16);
-  EXPECT_EQ(g.col_offset, 7);
+  EXPECT_EQ(g.col_offset, 11);
   const auto cleaned = remove_grid_lines(noisy, g);
   // Every grid pixel that is not a real edge is gone; real edges off the lines stay.
   auto grid = torch::zeros({1, H, W}, torch::kBool);
   grid[0].slice(0, 3, H, 16).fill_(true);
-  grid[0].slice(1, 7, W, 16).fill_(true);
+  grid[0].slice(1, 11, W, 16).fill_(true);
   EXPECT_TRUE((cleaned.masked_select(~grid) == truth.masked_select(~grid)).all().item<bool>());
   const auto spurious = cleaned.gt(0) & truth.eq(0);
   EXPECT_EQ(spurious.sum().item<int64_t>(), 0);
-  // Real edges crossing a grid line survive there: column 5 and the diagonal cross row 19.
+  // Real edges crossing a grid line survive there: column 5 and the diagonal cross row 19, the
+  // rectangle's top edge crosses columns 11 and 27.
   EXPECT_EQ(cleaned[0][19][5].item<uint8_t>(), 1);
   EXPECT_EQ(cleaned[0][19][24].item<uint8_t>(), 1);
+  EXPECT_EQ(cleaned[0][10][27].item<uint8_t>(), 1);
+  // Grid pixels next to (but not on) a crossing edge are removed.
+  EXPECT_EQ(cleaned[0][19][4].item<uint8_t>(), 0);
+  EXPECT_EQ(cleaned[0][19][6].item<uint8_t>(), 0);
 }
 
 TEST(GridLines, CleanMasksAndAllEdgeMasksAreLeftAlone) {

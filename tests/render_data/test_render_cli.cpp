@@ -16,14 +16,14 @@ namespace cgsr {
 namespace {
 namespace fs = std::filesystem;
 
-struct Run {
+struct CliRun {
   int code = -1;
   std::string output;
 };
 
-Run cgsr(const std::string& args) {
+CliRun cgsr(const std::string& args) {
   const std::string command = std::string(CGSR_BINARY) + " " + args + " 2>&1";
-  Run r;
+  CliRun r;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf{};
@@ -37,7 +37,7 @@ std::string tiny_config() { return std::string(CGSR_SOURCE_DIR) + "/configs/scen
 
 TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
   const fs::path out = test::temp_dir("cli_render") / "tiny";
-  const Run render = cgsr("render --config " + tiny_config() + " --out " + out.string());
+  const CliRun render = cgsr("render --config " + tiny_config() + " --out " + out.string());
   ASSERT_EQ(render.code, 0) << render.output;
   EXPECT_NE(render.output.find("per frame"), std::string::npos) << render.output;
   const DatasetManifest m = read_manifest(out);
@@ -47,25 +47,25 @@ TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
   EXPECT_TRUE(fs::exists(out / "config.yaml"));
   EXPECT_TRUE(fs::exists(out / "128x96" / "motion" / "000005.exr"));
 
-  const Run check = cgsr("data check " + out.string());
+  const CliRun check = cgsr("data check " + out.string());
   ASSERT_EQ(check.code, 0) << check.output;
   EXPECT_NE(check.output.find("problems     none"), std::string::npos) << check.output;
   EXPECT_NE(check.output.find("12 frame/resolution pairs"), std::string::npos) << check.output;
 
   // An interrupted render (a frame's file missing) resumes: only that frame is rendered again.
   fs::remove(out / "64x48" / "color" / "000002.png");
-  const Run resume = cgsr("render --config " + tiny_config() + " --out " + out.string());
+  const CliRun resume = cgsr("render --config " + tiny_config() + " --out " + out.string());
   ASSERT_EQ(resume.code, 0) << resume.output;
   EXPECT_NE(resume.output.find("rendered 1 frame(s) (5 resumed)"), std::string::npos) << resume.output;
   // A different configuration does not mix into the same directory.
-  const Run other = cgsr("render --config " + tiny_config() + " --set frames=7 --out " + out.string());
+  const CliRun other = cgsr("render --config " + tiny_config() + " --set frames=7 --out " + out.string());
   EXPECT_EQ(other.code, 2) << other.output;
   EXPECT_NE(other.output.find("different configuration"), std::string::npos) << other.output;
 
   // Damage: a corrupt depth file and a missing edge file are counted, named, and exit code 2.
   std::ofstream(out / "64x48" / "depth" / "000003.exr", std::ios::trunc) << "not an exr";
   fs::remove(out / "128x96" / "edge" / "000001.png");
-  const Run damaged = cgsr("data check " + out.string());
+  const CliRun damaged = cgsr("data check " + out.string());
   EXPECT_EQ(damaged.code, 2) << damaged.output;
   EXPECT_NE(damaged.output.find("64x48/depth/000003.exr: frame 3"), std::string::npos) << damaged.output;
   EXPECT_NE(damaged.output.find("128x96/edge/000001.png: frame 1: missing file"), std::string::npos) << damaged.output;
@@ -77,7 +77,7 @@ TEST(RenderCli, PreviewWritesAMontage) {
   const fs::path out = test::temp_dir("cli_preview") / "tiny";
   ASSERT_EQ(cgsr("render --config " + tiny_config() + " --set frames=2 --out " + out.string()).code, 0);
   const fs::path png = out.parent_path() / "preview.png";
-  const Run preview = cgsr("data preview " + out.string() + " --frame 1 --image " + png.string());
+  const CliRun preview = cgsr("data preview " + out.string() + " --frame 1 --image " + png.string());
   ASSERT_EQ(preview.code, 0) << preview.output;
   const auto image = read_image(png);
   EXPECT_EQ(image.size(2), 2 * 128 + 4);    // LR (enlarged) | HR
@@ -85,11 +85,11 @@ TEST(RenderCli, PreviewWritesAMontage) {
 }
 
 TEST(RenderCli, BadConfigsAreUserErrors) {
-  const Run scale = cgsr("render --config " + tiny_config() + " --set resolutions=[64x48,100x75] --out " +
+  const CliRun scale = cgsr("render --config " + tiny_config() + " --set resolutions=[64x48,100x75] --out " +
                          (test::temp_dir("cli_bad") / "x").string());
   EXPECT_EQ(scale.code, 2) << scale.output;
   EXPECT_NE(scale.output.find("not an integer scale"), std::string::npos) << scale.output;
-  const Run missing = cgsr("data check " + (test::temp_dir("cli_bad2") / "nothing").string());
+  const CliRun missing = cgsr("data check " + (test::temp_dir("cli_bad2") / "nothing").string());
   EXPECT_EQ(missing.code, 2) << missing.output;
 }
 
