@@ -13,6 +13,11 @@ packages=(
   libzip-dev libstb-dev                           # pk3 archives, TGA textures
   python3-torch                                   # torch.jit.load check of TorchScript exports
 )
+# Optional: clang with libFuzzer for fuzz/ (-DCGSR_FUZZ=ON), and the OpenArena game data (~400 MB)
+# for configs/scenes/oa_*.yaml; the tests need neither.
+if [ "${1:-}" = "--with-optional" ]; then
+  packages+=(clang libclang-rt-dev openarena-088-data openarena-data)
+fi
 # ONNX Runtime verification runs through the npm package onnxruntime-node; a machine
 # whose Node.js does not come from Debian already has npm.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
