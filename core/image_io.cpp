@@ -92,7 +92,9 @@ torch::Tensor read_image(const fs::path& path, const ImageReadOptions& options) 
   }
   as_float = as_float.isContinuous() ? as_float : as_float.clone();
   auto hwc = torch::from_blob(as_float.data, {as_float.rows, as_float.cols, c}, torch::kFloat32);
-  return hwc.permute({2, 0, 1}).contiguous();  // copies out of the cv::Mat
+  // clone(): for one channel the permuted view is already "contiguous", and contiguous() would
+  // return a view of the cv::Mat's memory, which is freed on return.
+  return hwc.permute({2, 0, 1}).clone(at::MemoryFormat::Contiguous);
 }
 
 std::vector<unsigned char> encode_image(const std::string& extension, const torch::Tensor& image,

@@ -19,7 +19,7 @@ namespace {
 
 config::Schema<Q3CameraOptions> camera_schema() {
   config::Schema<Q3CameraOptions> s;
-  s.field("length", &Q3CameraOptions::length, "game units the camera travels over the sequence").range(0, 1e6);
+  s.field("length", &Q3CameraOptions::length, "game units the camera travels over the sequence").range(64, 1e6);
   s.field("eye_height", &Q3CameraOptions::eye_height, "eye above the player origin (24 above the floor)")
       .range(0, 64);
   s.field("look_ahead", &Q3CameraOptions::look_ahead, "the camera looks at the path this far ahead")

@@ -6,10 +6,14 @@
 #include <torch/torch.h>
 
 #include <map>
+#include <random>
 #include <set>
 
 #include "export/exporter.h"
 #include "export/verification.h"
+#include "models/inherit.h"
+#include "pruning/magnitude_pruning.h"
+#include "search/search_space.h"
 #include "tests/export/export_cases.h"
 #include "tests/support/cli_runner.h"
 
@@ -54,6 +58,37 @@ TEST(Verification, EveryNetworkMatchesOurForwardInEveryRuntime) {
   EXPECT_EQ(ran["libtorch"], n);
   EXPECT_EQ(ran["python-torch"], n);
   EXPECT_TRUE(report.ok()) << report.table();
+  std::filesystem::remove_all(dir);
+}
+
+// What the search and pruning stages produce are plain specs with smaller, uneven widths and
+// inherited weights: they export and verify like any network.
+TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
+  const auto dir = test::scratch_dir("export-verify-searched-pruned");
+  SRNetwork parent = test::build_network(test::with_rit(default_spec("pan", 2), "lr", "concat"), 500);
+  const SearchSpace space(parent->spec(), SearchSpaceOptions());
+  std::mt19937_64 rng(5);
+  ArchSpec searched = space.sample(rng);
+  while (searched == parent->spec()) searched = space.sample(rng);
+  const std::vector<std::pair<std::string, SRNetwork>> nets = {
+      {"searched", inherit(*parent, searched).network},
+      {"magnitude_pruned", magnitude_prune(*parent, 0.5).network},
+  };
+  std::vector<VerifyCase> cases;
+  for (auto [name, net] : nets) {
+    EXPECT_LT(inference_parameter_count(*net), inference_parameter_count(*parent)) << name;
+    for (ExportFormat format : {ExportFormat::Onnx, ExportFormat::TorchScript}) {
+      ExportOptions o;
+      o.format = format;
+      o.width = kWidth;
+      o.height = kHeight;
+      const auto m = export_network(*net, dir / (name + (format == ExportFormat::Onnx ? ".onnx" : ".pt")), o);
+      cases.push_back(make_verify_case(*net, m, {{kWidth, kHeight}}, 7));
+    }
+  }
+  const VerifyReport report = verify_exports(cases);
+  EXPECT_EQ(report.checks.size(), 8u);  // 2 networks x 2 formats x 2 runtimes
+  EXPECT_EQ(report.passed(), 8) << report.table();
   std::filesystem::remove_all(dir);
 }
 

@@ -28,7 +28,7 @@ TEST(DynamicSampler, ScoresAndChoices) {
   o.channels = {"depth", "edge"};
   o.grid = 8;
   o.width = 4;
-  DynamicSamplers s(o, {3, 1, 5});
+  DynamicSamplers s(o, std::vector<int>{3, 1, 5});
   const auto x = torch::rand({6, 4, 8, 8});
   const auto scores = s->forward(x);
   ASSERT_EQ(scores.sizes(), (std::vector<int64_t>{6, 3, 5}));
@@ -46,7 +46,7 @@ TEST(DynamicSampler, KeepingPatternsPreservesTheirScores) {
   SamplerOptions o;
   o.channels = {"depth"};
   o.grid = 6;
-  DynamicSamplers s(o, {4, 3});
+  DynamicSamplers s(o, std::vector<int>{4, 3});
   const auto x = torch::rand({5, 2, 6, 6});
   torch::NoGradGuard no_grad;
   const auto before = s->forward(x);

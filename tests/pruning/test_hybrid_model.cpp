@@ -75,7 +75,8 @@ TEST(HybridModel, RoundTripsAndLoadsAsAPlainModel) {
   const Batch f = frame(7);
   const auto out = b.upscale(f);
   std::vector<int> choice;
-  for (const auto& [unit, k] : b.frame_details()["patterns"].items()) choice.push_back(k.get<int>());
+  const auto details = b.frame_details();  // a copy: iterating a temporary's items() would dangle
+  for (const auto& [unit, k] : details["patterns"].items()) choice.push_back(k.get<int>());
   PatternExecutor exec(*loaded.network, loaded.pool);
   EXPECT_TRUE(torch::allclose(out, exec.run(f.lr_color, f.lr_info, choice), 0, 1e-6));
   EXPECT_GE(b.frame_details()["choose_ms"].get<double>(), 0.0);

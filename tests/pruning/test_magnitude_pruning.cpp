@@ -23,7 +23,7 @@ TEST(MagnitudePruning, RemovesTheSmallestChannels) {
       b[c].mul_(c == 2 ? 0.3 : 0.01);
     }
   }
-  const Inheritance pruned = magnitude_prune(*net, 0.5);  // keeps 3 of 6
+  Inheritance pruned = magnitude_prune(*net, 0.5);  // keeps 3 of 6
   EXPECT_EQ(pruned.kept.at("block0_mid"), (std::vector<int64_t>{0, 3, 5}));
   EXPECT_EQ(pruned.network->spec().group_width("block0_mid"), 3);
   EXPECT_EQ(pruned.network->spec().group_width("block1_mid"), 3);

@@ -38,7 +38,7 @@ TEST(StaticPruning, RemovesExactlyTheNeverSelectedChannels) {
     const auto counts = counts_skipping_one(pool);
     StaticPruneOptions options;
     options.rit_threshold = 0;
-    const StaticPruning pruned = static_prune(*net, pool, counts, options);
+    StaticPruning pruned = static_prune(*net, pool, counts, options);
 
     // Widths are the unions of the selected patterns; the removed lists are their complements.
     PatternPool selected;
@@ -59,7 +59,9 @@ TEST(StaticPruning, RemovesExactlyTheNeverSelectedChannels) {
     }
     // Everything else is untouched.
     for (const auto& [group, width] : net->spec().widths.entries())
-      if (!expected.count(group)) EXPECT_EQ(pruned.network->spec().widths.at(group), width);
+      if (!expected.count(group)) {
+        EXPECT_EQ(pruned.network->spec().widths.at(group), width);
+      }
 
     // The smaller network is the dense network restricted to the union...
     const auto [color, info] = inputs_for(*net, 6, 5);
@@ -96,7 +98,7 @@ TEST(StaticPruning, LeavesOutUnusedRenderingChannelsAndTheGeometryHead) {
   const PatternPool pool = random_pool(units, 2, 1.0, 1);  // keep everything
   std::vector<std::vector<int64_t>> counts;
   for (const auto& u : pool.units) counts.push_back(std::vector<int64_t>(u.patterns.size(), 1));
-  const StaticPruning pruned = static_prune(*net, pool, counts, StaticPruneOptions{});
+  StaticPruning pruned = static_prune(*net, pool, counts, StaticPruneOptions{});
   EXPECT_EQ(pruned.rit_channels_dropped, (std::vector<std::string>{"normal_angle"}));
   EXPECT_EQ(pruned.network->spec().rit.channels, (std::vector<std::string>{"depth", "edge"}));
   EXPECT_FALSE(pruned.network->has_geometry_head());
