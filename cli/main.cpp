@@ -15,6 +15,7 @@
 #include "cli/commands/export.h"
 #include "cli/commands/render.h"
 #include "cli/commands/report.h"
+#include "cli/commands/run.h"
 #include "cli/commands/search.h"
 #include "cli/commands/train.h"
 #include "core/error.h"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   setup_prune(app);
   setup_report(app);
   setup_export(app);
+  setup_run(app);
 
   try {
     app.parse(argc, argv);

@@ -4,7 +4,9 @@ function(cgsr_target_defaults target)
   target_include_directories(${target} PUBLIC ${CGSR_SOURCE_ROOT})
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
   if(CGSR_SANITIZE)
-    target_compile_options(${target} PUBLIC -fsanitize=address,undefined -fno-omit-frame-pointer)
+    # Any undefined behaviour aborts (fails the test) instead of printing and going on.
+    target_compile_options(${target} PUBLIC -fsanitize=address,undefined -fno-sanitize-recover=undefined
+                                            -fno-omit-frame-pointer -g1)
     target_link_options(${target} PUBLIC -fsanitize=address,undefined)
   endif()
 endfunction()

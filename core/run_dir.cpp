@@ -9,14 +9,16 @@
 
 namespace cgsr {
 
-RunDir::RunDir(std::filesystem::path dir) : dir_(std::move(dir)) {
+RunDir::RunDir(std::filesystem::path dir, bool own_log) : dir_(std::move(dir)), own_log_(own_log) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw Error(dir_.string(), "cannot create the run directory: " + ec.message());
-  attach_log_file(dir_ / "log.txt");
+  if (own_log_) attach_log_file(dir_ / "log.txt");
 }
 
-RunDir::~RunDir() { finish_log_file(); }
+RunDir::~RunDir() {
+  if (own_log_) finish_log_file();
+}
 
 void RunDir::write_config(const YAML::Node& resolved) const {
   write_file_atomic(file("config.yaml"), config::to_yaml(resolved));

@@ -12,8 +12,9 @@ namespace cgsr {
 
 class RunDir {
  public:
-  // Creates the directory and starts logging into it.
-  explicit RunDir(std::filesystem::path dir);
+  // Creates the directory; with `own_log`, also logs into its log.txt until destroyed (a
+  // pipeline stage's directory shares the pipeline's log instead).
+  explicit RunDir(std::filesystem::path dir, bool own_log = true);
   ~RunDir();
   RunDir(const RunDir&) = delete;
   RunDir& operator=(const RunDir&) = delete;
@@ -26,6 +27,7 @@ class RunDir {
 
  private:
   std::filesystem::path dir_;
+  bool own_log_;
 };
 
 // "runs/<command>-YYYYmmdd-HHMMSS": the default --out of a command that produces artifacts.

@@ -1,0 +1,334 @@
+#include "cli/commands/run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <functional>
+
+#include "cli/commands/eval.h"
+#include "cli/commands/export.h"
+#include "cli/commands/prune.h"
+#include "cli/commands/render.h"
+#include "cli/commands/report.h"
+#include "cli/commands/search.h"
+#include "cli/commands/train.h"
+#include "cli/stage_cache.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/yaml_json.h"
+#include "export/exporter.h"
+#include "render_data/dataset.h"
+
+namespace fs = std::filesystem;
+
+namespace cgsr::cli {
+
+const std::vector<std::string>& pipeline_stages() {
+  static const std::vector<std::string> stages = {"render", "train",  "enhance", "search",
+                                                  "prune",  "export", "eval",    "report"};
+  return stages;
+}
+
+config::Schema<PipelineOptions> pipeline_schema() {
+  config::Schema<PipelineOptions> s;
+  s.field("name", &PipelineOptions::name, "run name; the default run directory is runs/<name>");
+  s.field("scene", &PipelineOptions::scene, "cgsr render config of the scene to render (or give data)");
+  s.field("data", &PipelineOptions::data, "an existing data set directory instead of rendering a scene");
+  s.field("baselines", &PipelineOptions::baselines, "classic upscalers in the report (bicubic is always there)")
+      .one_of(classic_upscalers().names());
+  s.block("train", &PipelineOptions::train, "cgsr train config of the plain backbone (data is filled in)");
+  s.block("enhance", &PipelineOptions::enhance, "cgsr train config of the CG-enhanced network (data, model filled in)");
+  s.block("search", &PipelineOptions::search, "cgsr search config (parent, data filled in)");
+  s.block("prune", &PipelineOptions::prune, "cgsr prune config (model, data, eval filled in)");
+  s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in")
+      .one_of(export_format_names());
+  s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames, latency runs)");
+  s.section("verdict", &PipelineOptions::verdict, verdict_schema(), "what the run must show");
+  s.field("from", &PipelineOptions::from, "rerun this stage and every later one").check(
+      [](const std::string& v) {
+        return v.empty() || std::find(pipeline_stages().begin(), pipeline_stages().end(), v) != pipeline_stages().end();
+      },
+      "must be one of: " + join(pipeline_stages()));
+  s.validate([](const PipelineOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (o.scene.empty() == o.data.empty())
+      at.child("scene").fail(node, "give exactly one of 'scene' (a scene to render) and 'data' (an existing data set)");
+  });
+  add_run_settings(s);
+  return s;
+}
+
+void setup_run(CLI::App& app) {
+  add_command<PipelineOptions>(
+      app, "run", "The whole pipeline: render, train, CG-enhance, search, prune, export, evaluate, report",
+      pipeline_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        flag_to_key(sub, flags, "--from", "from", "rerun this stage and every later one (" + join(pipeline_stages()) + ")");
+        flag_to_key(sub, flags, "--data", "data", "use this data set instead of rendering the scene");
+      },
+      [](const PipelineOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
+        // The default directory is stable (runs/<name>), so that a rerun finds its finished stages.
+        const fs::path dir = run_dir ? run_dir->path() : fs::path("runs") / options.name;
+        std::unique_ptr<RunDir> own;
+        if (!run_dir) {
+          own = std::make_unique<RunDir>(dir);
+          own->write_config(resolved);
+        }
+        return run_pipeline(options, resolved, dir);
+      },
+      /*always_run_dir=*/false);
+}
+
+namespace {
+
+// A stage's options: the keys of its section plus the keys the pipeline fills in (`filled`),
+// parsed with the subcommand's own schema, so errors name the run config's file, line and key.
+template <class T>
+T parse_stage(const config::Block& block, const config::Schema<T>& schema, const YAML::Node& filled,
+              const std::string& stage) {
+  const config::Cursor at = block.doc ? block.cursor() : config::Cursor{nullptr, stage};
+  const YAML::Node& given = block.node;
+  YAML::Node merged(YAML::NodeType::Map);
+  if (given && given.IsMap()) {
+    for (const auto& kv : given) merged.force_insert(kv.first, kv.second);
+  } else if (given && given.IsDefined() && !given.IsNull()) {
+    at.fail(given, "expected a map of keys, got " + config::detail::describe(given));
+  }
+  for (const auto& kv : filled) {
+    const std::string key = kv.first.as<std::string>();
+    if (given && given.IsMap() && given[key])
+      at.child(key).fail(given[key], "is filled in by cgsr run (from the earlier stages); remove it here");
+    merged[key] = kv.second;
+  }
+  T out{};
+  schema.parse(merged, out, at);
+  return out;
+}
+
+struct StageOutcome {
+  std::string hash;
+  nlohmann::ordered_json summary;
+  double seconds = 0;
+  bool skipped = false;
+};
+
+// Runs the stages in their directories, skipping the finished ones (cli/stage_cache.h).
+class StageRunner {
+ public:
+  StageRunner(fs::path root, std::string from, int stages) : root_(std::move(root)), from_(std::move(from)), total_(stages) {}
+
+  fs::path dir(const std::string& stage) const { return root_ / (stage == "render" ? "data" : stage); }
+
+  // `body(run_dir, resume)` does the stage's work and returns its results.
+  StageOutcome run(const std::string& stage, const YAML::Node& resolved, const std::vector<std::string>& upstream,
+                   const std::function<nlohmann::ordered_json(RunDir&, bool)>& body) {
+    ++index_;
+    forcing_ = forcing_ || stage == from_;
+    StageOutcome outcome;
+    outcome.hash = stage_hash(resolved, upstream);
+    const fs::path where = dir(stage);
+    if (!forcing_ && stage_is_current(where, outcome.hash)) {
+      spdlog::info("[{}/{}] {}: up to date in {}, skipped", index_, total_, stage, where.string());
+      outcome.summary = stage_summary(where);
+      outcome.skipped = true;
+      return outcome;
+    }
+    // An interrupted stage with the same inputs resumes; anything else starts afresh.
+    const fs::path started = where / "stage.started";
+    const bool resume = !forcing_ && fs::exists(started) && read_file(started) == outcome.hash;
+    if (!resume) {
+      fs::remove_all(where);
+      fs::create_directories(where);
+      write_file_atomic(started, outcome.hash);
+    }
+    spdlog::info("[{}/{}] {}{} -> {}", index_, total_, stage, resume ? " (resuming)" : "", where.string());
+    const auto t0 = std::chrono::steady_clock::now();
+    RunDir run_dir(where, /*own_log=*/false);
+    run_dir.write_config(resolved);
+    outcome.summary = body(run_dir, resume);
+    run_dir.write_results(outcome.summary);
+    mark_stage_done(where, outcome.hash, outcome.summary);
+    outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    spdlog::info("[{}/{}] {}: done in {:.0f} s", index_, total_, stage, outcome.seconds);
+    return outcome;
+  }
+
+ private:
+  fs::path root_;
+  std::string from_;
+  int total_, index_ = 0;
+  bool forcing_ = false;
+};
+
+YAML::Node run_settings_node(const PipelineOptions& o) {
+  YAML::Node n(YAML::NodeType::Map);
+  n["seed"] = o.seed;
+  n["threads"] = o.threads;
+  return n;
+}
+
+const EvalResult* find_result(const std::vector<EvalResult>& results, const std::string& name) {
+  for (const auto& r : results)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool render = options.data.empty();
+  StageRunner stages(root, options.from, static_cast<int>(pipeline_stages().size()) - (render ? 0 : 1));
+  nlohmann::ordered_json results;
+  results["config"] = yaml_to_json(resolved);
+  // No references into `results`: an ordered_json object is a vector, and inserting moves it.
+  auto record = [&](const std::string& stage, const StageOutcome& o) {
+    results["stages"][stage] = o.summary;
+    results["stage_seconds"][stage] = o.skipped ? nlohmann::ordered_json("cached") : nlohmann::ordered_json(o.seconds);
+  };
+
+  // render
+  std::string data_path = options.data, data_hash;
+  if (render) {
+    const config::Document scene = config::Document::load_file(options.scene);
+    RenderOptions r = config::parse_document(scene, render_schema());
+    r.seed = options.seed;
+    r.threads = options.threads;
+    const auto o = stages.run("render", render_schema().emit(r), {}, [&](RunDir& dir, bool) {
+      return run_render(r, dir.path());
+    });
+    record("render", o);
+    data_path = stages.dir("render").string();
+    data_hash = o.hash;
+  } else {
+    data_hash = stage_hash(YAML::Node(fs::absolute(options.data).string()), {});
+  }
+  const Dataset data = Dataset::open(data_path);
+  YAML::Node with_data = run_settings_node(options);
+  with_data["data"] = data_path;
+
+  // train: the plain backbone
+  TrainOptions backbone = parse_stage(options.train, train_schema(), with_data, "train");
+  const auto trained = stages.run("train", train_schema().emit(backbone), {data_hash}, [&](RunDir& dir, bool resume) {
+    backbone.resume = resume;
+    return run_train(backbone, train_schema().emit(backbone), dir);
+  });
+  record("train", trained);
+  const fs::path backbone_file = stages.dir("train") / "model.cgsr";
+
+  // enhance: backbone + RIT + geometry head, trained with the joint loss
+  YAML::Node enhance_filled = YAML::Clone(with_data);
+  enhance_filled["model"] = backbone_file.string();
+  TrainOptions enhanced = parse_stage(options.enhance, train_schema(), enhance_filled, "enhance");
+  enhanced.enhance.enabled = true;
+  const auto enhance = stages.run("enhance", train_schema().emit(enhanced), {data_hash, trained.hash},
+                                  [&](RunDir& dir, bool resume) {
+                                    enhanced.resume = resume;
+                                    return run_train(enhanced, train_schema().emit(enhanced), dir);
+                                  });
+  record("enhance", enhance);
+  const fs::path enhanced_file = stages.dir("enhance") / "model.cgsr";
+
+  // search: CG-enhanced -> CG-optimized
+  YAML::Node search_filled = YAML::Clone(with_data);
+  search_filled["parent"] = enhanced_file.string();
+  SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
+  const auto searched = stages.run("search", search_command_schema().emit(search), {data_hash, enhance.hash},
+                                   [&](RunDir& dir, bool resume) {
+                                     search.resume = resume;
+                                     return run_search_command(search, search_command_schema().emit(search), dir);
+                                   });
+  record("search", searched);
+  const fs::path searched_file = stages.dir("search") / "model.cgsr";
+
+  // prune: hybrid pruning of the CG-optimized network (evaluated with the pipeline's eval options)
+  const EvalOptions eval = parse_stage(options.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
+  YAML::Node prune_filled = YAML::Clone(with_data);
+  prune_filled["model"] = searched_file.string();
+  prune_filled["eval"] = eval_schema_fields().emit(eval);
+  PruneCommandOptions prune = parse_stage(options.prune, prune_command_schema(), prune_filled, "prune");
+  const auto pruned = stages.run("prune", prune_command_schema().emit(prune), {data_hash, searched.hash},
+                                 [&](RunDir& dir, bool resume) {
+                                   prune.resume = resume;
+                                   return run_prune(prune, prune_command_schema().emit(prune), dir);
+                                 });
+  record("prune", pruned);
+  const fs::path pruned_file = stages.dir("prune") / "pruned.cgsr";
+
+  // export: the CG-optimized and the pruned network, verified in the other runtimes
+  const Resolution lr = data.info().resolutions.front();
+  std::vector<ExportCommandOptions> exports;
+  YAML::Node export_config(YAML::NodeType::Sequence);
+  for (const auto& [model, stem] : {std::pair{searched_file, std::string("cg_optimized")},
+                                    std::pair{pruned_file, std::string("pruned")}}) {
+    for (const auto& format : options.export_formats) {
+      ExportCommandOptions e;
+      e.seed = options.seed;
+      e.threads = options.threads;
+      e.model = model.string();
+      e.format = format;
+      e.input = lr.name();
+      e.verify = true;
+      e.out = (stages.dir("export") / (stem + (format == "onnx" ? ".onnx" : ".pt"))).string();
+      exports.push_back(e);
+      export_config.push_back(export_schema().emit(e));
+    }
+  }
+  const auto exported = stages.run("export", export_config, {searched.hash, pruned.hash}, [&](RunDir&, bool) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::array();
+    for (const auto& e : exports) j.push_back(run_export(e));
+    return nlohmann::ordered_json{{"exports", j}};
+  });
+  record("export", exported);
+
+  // eval: classic baselines, the backbone and the CG-enhanced network (prune evaluated the rest)
+  EvalCommandOptions evaluation;
+  evaluation.seed = options.seed;
+  evaluation.threads = options.threads;
+  evaluation.data = data_path;
+  evaluation.scale = backbone.scale;
+  evaluation.eval = eval;
+  evaluation.models = {"bicubic"};
+  for (const auto& b : options.baselines)
+    if (b != "bicubic") evaluation.models.push_back(b);
+  evaluation.models.push_back(backbone_file.string());
+  evaluation.models.push_back(enhanced_file.string());
+  const auto evaluated = stages.run("eval", eval_schema().emit(evaluation), {data_hash, trained.hash, enhance.hash},
+                                    [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
+  record("eval", evaluated);
+
+  // report: one table and plot from both evaluations, then the verdict
+  ReportOptions report;
+  report.runs = {(stages.dir("eval") / "results.json").string(), (stages.dir("prune") / "results.json").string()};
+  const auto reported = stages.run("report", YAML::Node(report.runs), {evaluated.hash, pruned.hash},
+                                   [&](RunDir& dir, bool) { return run_report(report, dir); });
+  record("report", reported);
+  if (reported.skipped) std::printf("%s", read_file(stages.dir("report") / "report.md").c_str());
+
+  const std::vector<EvalResult> evaluations = collect_evaluations(report.runs);
+  const std::string searched_name = searched.summary.at("name").get<std::string>();
+  PipelineResults roles;
+  roles.bicubic = find_result(evaluations, "bicubic");
+  roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
+  roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
+  roles.cg_optimized = find_result(evaluations, pruned.summary.at("name").get<std::string>());
+  roles.pruned = find_result(evaluations, pruned.summary.at("name").get<std::string>() + " hybrid");
+  if (!roles.bicubic || !roles.backbone || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
+    throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + searched_name + ")",
+                ErrorKind::Internal);
+  const Verdict verdict = judge_pipeline(roles, options.verdict);
+  write_file_atomic(root / "verdict.txt", verdict.text());
+  results["verdict"] = verdict.to_json();
+  results["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_file_atomic(root / "results.json", results.dump(2) + "\n");
+
+  std::printf("\n%s", verdict.text().c_str());
+  std::printf("report: %s, verdict: %s, run: %s (%.0f s)\n", (stages.dir("report") / "report.md").string().c_str(),
+              (root / "verdict.txt").string().c_str(), root.string().c_str(), results["seconds"].get<double>());
+  if (!verdict.passed() && options.verdict.fail_run)
+    throw Error(root.string(), "the verdict failed " + std::to_string(verdict.failed()) + " check(s) (see verdict.txt)",
+                ErrorKind::Internal);
+  return results;
+}
+
+}  // namespace cgsr::cli

@@ -1,0 +1,54 @@
+#pragma once
+// The verdict of `cgsr run`: does this run show the CGSR story? Checks, on the held-out
+// evaluations of one run (all measured in the same process):
+//   - every network beats bicubic PSNR;
+//   - the CG-enhanced network is at least as good as the plain backbone it started from;
+//   - the search cuts params, MACs and latency of the CG-enhanced network, losing at most
+//     `max_search_loss_db` PSNR;
+//   - pruning cuts params, MACs and latency of the searched network, losing at most
+//     `max_prune_loss_db` PSNR.
+// Every figure in a check's detail comes from the evaluations; the thresholds are the config's.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "train/evaluation.h"
+
+namespace cgsr::cli {
+
+struct VerdictOptions {
+  double max_search_loss_db = 0.3;  // PSNR the CG-optimized network may lose against its parent
+  double max_prune_loss_db = 0.3;   // PSNR the pruned network may lose against its input
+  bool fail_run = true;             // a failed check makes `cgsr run` exit with an error
+};
+config::Schema<VerdictOptions> verdict_schema();
+
+// The evaluations a verdict needs, by role; a role left null is not checked.
+struct PipelineResults {
+  const EvalResult* bicubic = nullptr;
+  const EvalResult* backbone = nullptr;      // plain backbone (e.g. PAN x2)
+  const EvalResult* cg_enhanced = nullptr;   // backbone + RIT
+  const EvalResult* cg_optimized = nullptr;  // the search's pick, trained longer
+  const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network
+  std::vector<const EvalResult*> networks() const;  // every non-null learned model
+};
+
+struct VerdictCheck {
+  std::string claim;   // e.g. "search cuts params"
+  bool passed = false;
+  std::string detail;  // the figures behind it
+};
+
+struct Verdict {
+  std::vector<VerdictCheck> checks;
+  bool passed() const;
+  int failed() const;
+  std::string text() const;  // one line per check, then a summary line
+  nlohmann::ordered_json to_json() const;
+};
+
+Verdict judge_pipeline(const PipelineResults& results, const VerdictOptions& options);
+
+}  // namespace cgsr::cli
