@@ -26,13 +26,20 @@ torch::Tensor require(const torch::Tensor& t, const char* name) {
 }
 }  // namespace
 
-torch::Tensor visualize(const Frame& f, PreviewChannel channel, double near_plane, double far_plane, double motion_scale) {
+torch::Tensor visualize(const Frame& f, PreviewChannel channel, double motion_scale) {
   switch (channel) {
     case PreviewChannel::Color: return f.color_float();
     case PreviewChannel::Depth: {
-      // Inverse depth reads well at every distance; normalize_depth is 1 at the far plane.
-      const auto d = 1.0f - normalize_depth(require(f.depth, "depth"), near_plane, far_plane);
-      return d.pow(0.5).expand({3, f.height, f.width}).contiguous();
+      // Log depth over the frame's own range, near bright, far grey, sky black. (The z-buffer
+      // form the network sees, normalize_depth, is nearly 1 beyond a few metres and shows nothing.)
+      const auto z = require(f.depth, "depth").to(torch::kFloat32);
+      const auto geometry = torch::isfinite(z) & (z > 0);
+      if (!geometry.any().item<bool>()) return torch::zeros({3, f.height, f.width});
+      const auto log_z = torch::log(torch::where(geometry, z, torch::ones({})));
+      const auto seen = log_z.masked_select(geometry);
+      const float lo = seen.min().item<float>(), range = std::max(seen.max().item<float>() - lo, 1e-6f);
+      const auto v = torch::where(geometry, 1.0f - 0.8f * (log_z - lo) / range, torch::zeros({}));
+      return v.expand({3, f.height, f.width}).contiguous();
     }
     case PreviewChannel::Normal: {
       const auto n = require(f.normal, "normal").to(torch::kFloat32);
@@ -56,8 +63,7 @@ torch::Tensor visualize(const Frame& f, PreviewChannel channel, double near_plan
   return {};
 }
 
-torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels, double near_plane,
-                      double far_plane) {
+torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels) {
   if (hr.width % lr.width != 0 || hr.width / lr.width != hr.height / lr.height || hr.height % lr.height != 0)
     throw Error("preview", "the HR frame is not an integer multiple of the LR frame");
   const int s = hr.width / lr.width, gap = 4;
@@ -65,8 +71,8 @@ torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<Previe
   auto canvas = torch::ones({3, static_cast<int64_t>(channels.size()) * (H + gap) - gap, 2 * W + gap});
   for (size_t row = 0; row < channels.size(); ++row) {
     // Motion is in pixels of its own resolution: scale the LR colour wheel like the HR one.
-    const auto a = visualize(lr, channels[row], near_plane, far_plane, 8.0 / s);
-    const auto b = visualize(hr, channels[row], near_plane, far_plane, 8.0);
+    const auto a = visualize(lr, channels[row], 8.0 / s);
+    const auto b = visualize(hr, channels[row], 8.0);
     const auto big = a.repeat_interleave(s, 1).repeat_interleave(s, 2);
     const int64_t y = static_cast<int64_t>(row) * (H + gap);
     canvas.slice(1, y, y + H).slice(2, 0, W).copy_(big);

@@ -15,15 +15,13 @@ enum class PreviewChannel { Color, Depth, Normal, NormalAngle, Edge, Motion };
 const std::vector<std::string>& preview_channel_names();  // color, depth, normal, normal_angle, edge, motion
 PreviewChannel preview_channel_from_name(const std::string& name);
 
-// float32 [3,H,W] in [0,1]: colour as is; depth as grey of normalize_depth (near white, far
-// black, sky black); normals as (n + 1) / 2 with black sky; normal angle and edges as grey;
+// float32 [3,H,W] in [0,1]: colour as is; depth as grey of log depth over the frame's range
+// (near white, far grey, sky black); normals as (n + 1) / 2 with black sky; normal angle and edges as grey;
 // motion as hue = direction, brightness = magnitude (relative to `motion_scale` pixels).
-torch::Tensor visualize(const Frame& frame, PreviewChannel channel, double near_plane, double far_plane,
-                        double motion_scale = 8.0);
+torch::Tensor visualize(const Frame& frame, PreviewChannel channel, double motion_scale = 8.0);
 
 // Rows = channels; columns = LR enlarged to the HR size by pixel replication, then HR. A 4-pixel
 // gap separates cells. Requires hr = s x lr for an integer s.
-torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels, double near_plane,
-                      double far_plane);
+torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels);
 
 }  // namespace cgsr

@@ -56,7 +56,7 @@ nlohmann::ordered_json run_data_preview(const DataPreviewOptions& options) {
   }
   std::vector<PreviewChannel> rows;
   for (const auto& c : options.channels) rows.push_back(preview_channel_from_name(c));
-  const auto image = montage(lr, hr, rows, data.info().near_plane, data.info().far_plane);
+  const auto image = montage(lr, hr, rows);
   write_image(options.image, image);
   std::printf("wrote %s (%lldx%lld)\n", options.image.c_str(), static_cast<long long>(image.size(2)),
               static_cast<long long>(image.size(1)));
