@@ -177,8 +177,7 @@ const EvalResult* find_result(const std::vector<EvalResult>& results, const std:
 
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
   const auto t0 = std::chrono::steady_clock::now();
-  const bool render = options.data.empty();
-  StageRunner stages(root, options.from, static_cast<int>(pipeline_stages().size()) - (render ? 0 : 1));
+  StageRunner stages(root, options.from, static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1));
   nlohmann::ordered_json results;
   results["config"] = yaml_to_json(resolved);
   // No references into `results`: an ordered_json object is a vector, and inserting moves it.
@@ -187,73 +186,79 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
     results["stage_seconds"][stage] = o.skipped ? nlohmann::ordered_json("cached") : nlohmann::ordered_json(o.seconds);
   };
 
-  // render
-  std::string data_path = options.data, data_hash;
+  // Every stage's options first, so that a mistake anywhere in the config stops the run before
+  // its first stage rather than after an hour of training.
+  const bool render = options.data.empty();
+  const std::string data_path = render ? stages.dir("render").string() : options.data;
+  const fs::path backbone_file = stages.dir("train") / "model.cgsr";
+  const fs::path enhanced_file = stages.dir("enhance") / "model.cgsr";
+  const fs::path searched_file = stages.dir("search") / "model.cgsr";
+  const fs::path pruned_file = stages.dir("prune") / "pruned.cgsr";
+  RenderOptions scene;
   if (render) {
-    const config::Document scene = config::Document::load_file(options.scene);
-    RenderOptions r = config::parse_document(scene, render_schema());
-    r.seed = options.seed;
-    r.threads = options.threads;
-    const auto o = stages.run("render", render_schema().emit(r), {}, [&](RunDir& dir, bool) {
-      return run_render(r, dir.path());
+    scene = config::parse_document(config::Document::load_file(options.scene), render_schema());
+    scene.seed = options.seed;
+    scene.threads = options.threads;
+  }
+  YAML::Node with_data = run_settings_node(options);
+  with_data["data"] = data_path;
+  TrainOptions backbone = parse_stage(options.train, train_schema(), with_data, "train");
+  YAML::Node enhance_filled = YAML::Clone(with_data);
+  enhance_filled["model"] = backbone_file.string();
+  TrainOptions enhanced = parse_stage(options.enhance, train_schema(), enhance_filled, "enhance");
+  enhanced.enhance.enabled = true;
+  YAML::Node search_filled = YAML::Clone(with_data);
+  search_filled["parent"] = enhanced_file.string();
+  SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
+  const EvalOptions eval = parse_stage(options.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
+  YAML::Node prune_filled = YAML::Clone(with_data);
+  prune_filled["model"] = searched_file.string();
+  prune_filled["eval"] = eval_schema_fields().emit(eval);
+  PruneCommandOptions prune = parse_stage(options.prune, prune_command_schema(), prune_filled, "prune");
+
+  // render
+  std::string data_hash;
+  if (render) {
+    const auto o = stages.run("render", render_schema().emit(scene), {}, [&](RunDir& dir, bool) {
+      return run_render(scene, dir.path());
     });
     record("render", o);
-    data_path = stages.dir("render").string();
     data_hash = o.hash;
   } else {
     data_hash = stage_hash(YAML::Node(fs::absolute(options.data).string()), {});
   }
   const Dataset data = Dataset::open(data_path);
-  YAML::Node with_data = run_settings_node(options);
-  with_data["data"] = data_path;
 
   // train: the plain backbone
-  TrainOptions backbone = parse_stage(options.train, train_schema(), with_data, "train");
   const auto trained = stages.run("train", train_schema().emit(backbone), {data_hash}, [&](RunDir& dir, bool resume) {
     backbone.resume = resume;
     return run_train(backbone, train_schema().emit(backbone), dir);
   });
   record("train", trained);
-  const fs::path backbone_file = stages.dir("train") / "model.cgsr";
 
-  // enhance: backbone + RIT + geometry head, trained with the joint loss
-  YAML::Node enhance_filled = YAML::Clone(with_data);
-  enhance_filled["model"] = backbone_file.string();
-  TrainOptions enhanced = parse_stage(options.enhance, train_schema(), enhance_filled, "enhance");
-  enhanced.enhance.enabled = true;
+  // enhance: backbone + RIT (+ geometry head), trained with the joint loss
   const auto enhance = stages.run("enhance", train_schema().emit(enhanced), {data_hash, trained.hash},
                                   [&](RunDir& dir, bool resume) {
                                     enhanced.resume = resume;
                                     return run_train(enhanced, train_schema().emit(enhanced), dir);
                                   });
   record("enhance", enhance);
-  const fs::path enhanced_file = stages.dir("enhance") / "model.cgsr";
 
   // search: CG-enhanced -> CG-optimized
-  YAML::Node search_filled = YAML::Clone(with_data);
-  search_filled["parent"] = enhanced_file.string();
-  SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
   const auto searched = stages.run("search", search_command_schema().emit(search), {data_hash, enhance.hash},
                                    [&](RunDir& dir, bool resume) {
                                      search.resume = resume;
                                      return run_search_command(search, search_command_schema().emit(search), dir);
                                    });
   record("search", searched);
-  const fs::path searched_file = stages.dir("search") / "model.cgsr";
 
   // prune: hybrid pruning of the CG-optimized network (evaluated with the pipeline's eval options)
-  const EvalOptions eval = parse_stage(options.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
-  YAML::Node prune_filled = YAML::Clone(with_data);
-  prune_filled["model"] = searched_file.string();
-  prune_filled["eval"] = eval_schema_fields().emit(eval);
-  PruneCommandOptions prune = parse_stage(options.prune, prune_command_schema(), prune_filled, "prune");
   const auto pruned = stages.run("prune", prune_command_schema().emit(prune), {data_hash, searched.hash},
                                  [&](RunDir& dir, bool resume) {
                                    prune.resume = resume;
                                    return run_prune(prune, prune_command_schema().emit(prune), dir);
                                  });
   record("prune", pruned);
-  const fs::path pruned_file = stages.dir("prune") / "pruned.cgsr";
 
   // export: the CG-optimized and the pruned network, verified in the other runtimes
   const Resolution lr = data.info().resolutions.front();

@@ -1,0 +1,97 @@
+// The verdict of `cgsr run`: each claim passes or fails on the figures it is given, and a missing
+// measurement is a failed check, never a silent pass.
+#include <gtest/gtest.h>
+
+#include "cli/pipeline_verdict.h"
+
+using namespace cgsr;
+using namespace cgsr::cli;
+
+namespace {
+EvalResult result(const std::string& name, double psnr, int64_t params, int64_t macs, double latency_ms) {
+  EvalResult r;
+  r.name = name;
+  r.psnr = psnr;
+  if (params > 0) {
+    Complexity c;
+    c.params = params;
+    c.macs = macs;
+    r.cost = c;
+  }
+  if (latency_ms > 0) {
+    LatencyStats l;
+    l.median_ms = latency_ms;
+    l.runs = 5;
+    r.latency = l;
+  }
+  return r;
+}
+
+const VerdictCheck* find(const Verdict& v, const std::string& claim) {
+  for (const auto& c : v.checks)
+    if (c.claim == claim) return &c;
+  return nullptr;
+}
+
+struct Story {
+  EvalResult bicubic = result("bicubic", 24.0, 0, 0, 2.0);
+  EvalResult pan = result("PAN", 26.0, 272000, 20000000, 100.0);
+  EvalResult cg = result("CG", 26.2, 280000, 21000000, 110.0);
+  EvalResult opt = result("OPT", 26.1, 150000, 11000000, 60.0);
+  EvalResult pruned = result("P", 26.0, 60000, 4000000, 30.0);
+  PipelineResults roles() const { return {&bicubic, &pan, &cg, &opt, &pruned}; }
+};
+}  // namespace
+
+TEST(PipelineVerdict, TheExpectedStoryPassesEveryCheck) {
+  const Story s;
+  const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
+  // 4 networks above bicubic, CG >= PAN, and 4 checks each for search and pruning.
+  EXPECT_EQ(v.checks.size(), 4u + 1u + 4u + 4u);
+  EXPECT_TRUE(v.passed()) << v.text();
+  EXPECT_NE(v.text().find("all 13 checks pass"), std::string::npos);
+  EXPECT_EQ(v.to_json()["passed"], true);
+}
+
+TEST(PipelineVerdict, EachClaimFailsOnItsOwn) {
+  {
+    Story s;
+    s.pruned.psnr = 23.9;  // below bicubic, and a 2.2 dB loss
+    const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
+    EXPECT_FALSE(find(v, "P beats bicubic")->passed);
+    EXPECT_FALSE(find(v, "pruning loses at most 0.3 dB")->passed);
+    EXPECT_EQ(v.failed(), 2) << v.text();
+  }
+  {
+    Story s;
+    s.cg.psnr = 25.99;
+    const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
+    EXPECT_FALSE(find(v, "CG-enhanced at least as good as PAN")->passed);
+  }
+  {
+    Story s;
+    s.opt.latency->median_ms = 110.0;  // equal is not a cut
+    const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
+    EXPECT_FALSE(find(v, "search cuts latency")->passed);
+    EXPECT_TRUE(find(v, "search cuts params")->passed);
+    EXPECT_EQ(v.failed(), 1);
+  }
+  {
+    Story s;
+    s.opt.psnr = 25.85;  // 0.35 dB below its parent: over 0.3, within 0.4
+    VerdictOptions o;
+    EXPECT_FALSE(judge_pipeline(s.roles(), o).passed());
+    o.max_search_loss_db = 0.4;
+    EXPECT_TRUE(judge_pipeline(s.roles(), o).passed());
+  }
+}
+
+TEST(PipelineVerdict, MissingMeasurementsFail) {
+  Story s;
+  s.pruned.latency.reset();
+  s.pruned.cost.reset();
+  const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
+  EXPECT_FALSE(find(v, "pruning cuts latency")->passed);
+  EXPECT_FALSE(find(v, "pruning cuts params and MACs")->passed);
+  EXPECT_NE(v.text().find("FAILED"), std::string::npos);
+}

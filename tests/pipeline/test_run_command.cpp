@@ -1,0 +1,151 @@
+// `cgsr run` end to end on the tiny scene with tiny schedules: every stage leaves its artifacts
+// and a finished-stage record, a rerun skips everything, `--from` and a changed stage config
+// rerun exactly the stages they should, and a stage's config error names the run config's key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/cli_runner.h"
+
+using namespace cgsr::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kConfig = R"(name: tiny-pipeline
+scene: SCENE
+baselines: [bicubic, nearest]
+train:
+  model: pan
+  name: PAN x2
+  schedule: {steps: 6, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, checkpoint_every: 3}
+enhance:
+  name: CG-enhanced PAN x2
+  enhance: {rit: {channels: [depth, normal_angle, edge], width: 8}, geometry: {enabled: true, width: 8}}
+  schedule: {steps: 4, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+search:
+  name: CG-optimized PAN x2
+  search: {population: 2, selection_ratio: 0.5, generations: 1, min_candidates: 1, tolerance_db: 100}
+  candidate:
+    schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+  final: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+prune:
+  pool_frames: 2
+  pool: {keep_rate: 0.5, size: 2}
+  sampler: {grid: 4, width: 2}
+  warmup_steps: 2
+  finetune:
+    epochs: 0
+    schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+eval: {max_frames: 2, latency_runs: 1}
+verdict: {fail_run: false}
+)";
+
+// The pipeline config above, on the tiny scene, written into `dir`.
+fs::path write_config(const fs::path& dir) {
+  std::string config = kConfig;
+  config.replace(config.find("SCENE"), 5, std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
+  const auto file = dir / "pipeline.yaml";
+  std::ofstream(file) << config;
+  return file;
+}
+
+nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(slurp(path)); }
+
+// Stage name -> "ran" / "skipped", from the log lines of one cgsr run.
+std::map<std::string, std::string> stage_actions(const std::string& log) {
+  std::map<std::string, std::string> out;
+  for (const std::string stage : {"render", "train", "enhance", "search", "prune", "export", "eval", "report"}) {
+    if (log.find("] " + stage + ": up to date") != std::string::npos)
+      out[stage] = "skipped";
+    else if (log.find("] " + stage + ": done in") != std::string::npos)
+      out[stage] = "ran";
+  }
+  return out;
+}
+
+void expect_actions(const CliResult& r, const std::map<std::string, std::string>& expected) {
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto actions = stage_actions(r.err);
+  for (const auto& [stage, action] : expected) {
+    ASSERT_TRUE(actions.count(stage)) << stage << "\n" << r.err;
+    EXPECT_EQ(actions.at(stage), action) << stage;
+  }
+}
+
+}  // namespace
+
+TEST(RunCommand, RunsEveryStageThenCachesThem) {
+  const auto dir = scratch_dir("run-command");
+  const auto config_file = write_config(dir);
+  const auto out = dir / "run";
+  const std::string args = "run --config " + config_file.string() + " --out " + out.string() + " --threads 2 --seed 3";
+
+  const CliResult first = run_cgsr(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  for (const auto& [stage, action] : stage_actions(first.err)) EXPECT_EQ(action, "ran") << stage;
+  EXPECT_EQ(stage_actions(first.err).size(), 8u) << first.err;
+  for (const std::string stage : {"data", "train", "enhance", "search", "prune", "export", "eval", "report"})
+    EXPECT_TRUE(read_json(out / stage / "stage.json")["done"].get<bool>()) << stage;
+  for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
+                                 "export/cg_optimized.onnx", "export/pruned.onnx", "export/pruned.pt",
+                                 "report/report.md", "verdict.txt", "results.json", "log.txt"})
+    EXPECT_TRUE(fs::exists(out / file)) << file;
+
+  // The report holds every model of the pipeline; the verdict judges them.
+  const std::string report = slurp(out / "report" / "report.md");
+  for (const std::string row : {"bicubic", "nearest", "PAN x2", "CG-enhanced PAN x2", "CG-optimized PAN x2",
+                                "CG-optimized PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
+    EXPECT_NE(report.find("| " + row + " "), std::string::npos) << row << "\n" << report;
+  const auto results = read_json(out / "results.json");
+  EXPECT_GE(results["verdict"]["checks"].size(), 13u);
+  EXPECT_NE(first.out.find("verdict:"), std::string::npos);
+
+  // A rerun finds every stage finished.
+  const CliResult again = run_cgsr(args);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  for (const auto& [stage, action] : stage_actions(again.err)) EXPECT_EQ(action, "skipped") << stage;
+  EXPECT_EQ(stage_actions(again.err).size(), 8u);
+  EXPECT_NE(again.out.find("verdict:"), std::string::npos);  // still printed
+
+  // --from eval reruns eval and report only.
+  expect_actions(run_cgsr(args + " --from eval"),
+                 {{"prune", "skipped"}, {"export", "skipped"}, {"eval", "ran"}, {"report", "ran"}});
+
+  // A changed search config reruns search and what depends on it, not the trainings before it,
+  // nor eval (which reads neither search nor prune).
+  expect_actions(run_cgsr(args + " --set search.final.steps=3"),
+                 {{"train", "skipped"}, {"enhance", "skipped"}, {"search", "ran"}, {"prune", "ran"},
+                  {"eval", "skipped"}, {"report", "ran"}});
+  fs::remove_all(dir);
+}
+
+TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
+  const auto dir = scratch_dir("run-command-errors");
+  const auto config_file = write_config(dir);
+  const std::string base = "run --config " + config_file.string() + " --out " + (dir / "run").string();
+
+  const CliResult typo = run_cgsr(base + " --set train.schedule.stepz=3");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.err.find("train.schedule.stepz: unknown key 'stepz' (did you mean 'steps'?)"), std::string::npos)
+      << typo.err;
+  // A mistake in the last stage's section stops the run before the first stage renders anything.
+  const CliResult late = run_cgsr(base + " --set prune.pool.keep_rate=7");
+  EXPECT_EQ(late.exit_code, 2);
+  EXPECT_NE(late.err.find("prune.pool.keep_rate: must be in"), std::string::npos) << late.err;
+  EXPECT_FALSE(fs::exists(dir / "run" / "data" / "manifest.yaml"));
+
+  const CliResult filled = run_cgsr(base + " --set search.parent=x.cgsr");
+  EXPECT_EQ(filled.exit_code, 2);
+  EXPECT_NE(filled.err.find("search.parent: is filled in by cgsr run"), std::string::npos) << filled.err;
+
+  const CliResult both = run_cgsr(base + " --set data=somewhere");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.err.find("exactly one of 'scene'"), std::string::npos) << both.err;
+
+  const CliResult stage = run_cgsr(base + " --from deploy");
+  EXPECT_EQ(stage.exit_code, 2);
+  EXPECT_NE(stage.err.find("from: must be one of: render, train"), std::string::npos) << stage.err;
+  fs::remove_all(dir);
+}
