@@ -31,6 +31,9 @@ void init_logging(const std::string& level) {
     console->set_pattern("[%H:%M:%S] %^%l%$ %v");
     s.sinks->add_sink(console);
     auto logger = std::make_shared<spdlog::logger>("cgsr", s.sinks);
+    // Every message reaches the log file at once (the file sink buffers otherwise): a killed run's
+    // log.txt.partial then holds everything up to the kill, not an empty or cut-off buffer.
+    logger->flush_on(spdlog::level::trace);
     spdlog::set_default_logger(logger);
   }
   const auto parsed = spdlog::level::from_str(level);

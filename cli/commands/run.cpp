@@ -137,6 +137,10 @@ class StageRunner {
     const fs::path started = where / "stage.started";
     const bool resume = !forcing_ && fs::exists(started) && read_file(started) == outcome.hash;
     if (!resume) {
+      // Only ever delete what an earlier cgsr run made: never a user's folder that happens to
+      // sit where a stage goes (e.g. --out . next to a folder named data).
+      if (fs::exists(where) && !fs::is_empty(where) && !fs::exists(started) && !fs::exists(where / "stage.json"))
+        throw Error(where.string(), "exists and was not made by cgsr run; move it or choose another --out");
       fs::remove_all(where);
       fs::create_directories(where);
       write_file_atomic(started, outcome.hash);

@@ -144,6 +144,15 @@ TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   EXPECT_EQ(both.exit_code, 2);
   EXPECT_NE(both.err.find("exactly one of 'scene'"), std::string::npos) << both.err;
 
+  // A folder where a stage goes that cgsr run did not make is never deleted.
+  const auto foreign = dir / "other" / "train";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "notes.txt") << "mine";
+  const CliResult kept = run_cgsr("run --config " + config_file.string() + " --out " + (dir / "other").string());
+  EXPECT_EQ(kept.exit_code, 2);
+  EXPECT_NE(kept.err.find("exists and was not made by cgsr run"), std::string::npos) << kept.err;
+  EXPECT_EQ(slurp(foreign / "notes.txt"), "mine");
+
   const CliResult stage = run_cgsr(base + " --from deploy");
   EXPECT_EQ(stage.exit_code, 2);
   EXPECT_NE(stage.err.find("from: must be one of: render, train"), std::string::npos) << stage.err;
