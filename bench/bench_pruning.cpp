@@ -125,27 +125,24 @@ int main(int argc, char** argv) {
   struct Target {
     std::string name;
     std::function<void()> run;
-    std::vector<double> ms;
   };
   std::vector<Target> targets = {
-      {"dense", [&] { infer(*dense, frame.lr_color, pick(frame, dense->input_channels())); }, {}},
-      {"static", [&] { infer(*static_net, frame.lr_color, pick(frame, static_net->input_channels())); }, {}},
-      {"magnitude 0.5", [&] { infer(*mmp, frame.lr_color, pick(frame, mmp->input_channels())); }, {}},
+      {"dense", [&] { infer(*dense, frame.lr_color, pick(frame, dense->input_channels())); }},
+      {"static", [&] { infer(*static_net, frame.lr_color, pick(frame, static_net->input_channels())); }},
+      {"magnitude 0.5", [&] { infer(*mmp, frame.lr_color, pick(frame, mmp->input_channels())); }},
       {"hybrid", [&] {
          hybrid->previous_frame(previous);
          hybrid->upscale(frame);
-       }, {}},
-      {"hybrid: choosing only", [&] { hybrid->choose(frame); }, {}},
+       }},
+      {"hybrid: choosing only", [&] { hybrid->choose(frame); }},
   };
-  for (auto& t : targets) measure_latency(t.run, /*warmup=*/2, /*runs=*/1);
-  for (int r = 0; r < rounds; ++r)
-    for (auto& t : targets) t.ms.push_back(measure_latency(t.run, 0, 1).median_ms);
+  std::vector<std::function<void()>> runs;
+  for (const auto& t : targets) runs.push_back(t.run);
+  const auto stats = measure_latency_interleaved(runs, /*warmup=*/2, rounds);
   std::printf("input %s (x2), %d threads, %d interleaved rounds, medians\n", input.c_str(), thread_count(), rounds);
   std::printf("%-24s %12s %10s\n", "target", "median ms", "vs dense");
-  const double base = median(targets.front().ms);
-  for (const auto& t : targets) {
-    const double m = median(t.ms);
-    std::printf("%-24s %12.3f %10.3f\n", t.name.c_str(), m, m / base);
-  }
+  for (size_t i = 0; i < targets.size(); ++i)
+    std::printf("%-24s %12.3f %10.3f\n", targets[i].name.c_str(), stats[i].median_ms,
+                stats[i].median_ms / stats.front().median_ms);
   return 0;
 }

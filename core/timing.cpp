@@ -14,20 +14,37 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-LatencyStats measure_latency(const std::function<void()>& run, int warmup, int runs) {
-  for (int i = 0; i < warmup; ++i) run();
-  std::vector<double> ms;
-  for (int i = 0; i < std::max(1, runs); ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    run();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
+namespace {
+LatencyStats summarize(const std::vector<double>& ms) {
   LatencyStats s;
   s.median_ms = median(ms);
   s.min_ms = *std::min_element(ms.begin(), ms.end());
   s.max_ms = *std::max_element(ms.begin(), ms.end());
   s.runs = static_cast<int>(ms.size());
   return s;
+}
+
+double time_ms(const std::function<void()>& run) {
+  const auto start = std::chrono::steady_clock::now();
+  run();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+LatencyStats measure_latency(const std::function<void()>& run, int warmup, int runs) {
+  return measure_latency_interleaved({run}, warmup, runs).front();
+}
+
+std::vector<LatencyStats> measure_latency_interleaved(const std::vector<std::function<void()>>& runs, int warmup,
+                                                      int rounds) {
+  for (const auto& run : runs)
+    for (int i = 0; i < warmup; ++i) run();
+  std::vector<std::vector<double>> ms(runs.size());
+  for (int r = 0; r < std::max(1, rounds); ++r)
+    for (size_t t = 0; t < runs.size(); ++t) ms[t].push_back(time_ms(runs[t]));
+  std::vector<LatencyStats> out;
+  for (const auto& m : ms) out.push_back(summarize(m));
+  return out;
 }
 
 }  // namespace cgsr

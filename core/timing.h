@@ -14,6 +14,12 @@ struct LatencyStats {
 
 LatencyStats measure_latency(const std::function<void()>& run, int warmup = 2, int runs = 10);
 
+// Several targets timed in interleaved rounds (one run of each per round, after `warmup` runs
+// of each), so that load changing on a shared machine hits all of them alike and their ratios
+// hold. One LatencyStats per target, in order.
+std::vector<LatencyStats> measure_latency_interleaved(const std::vector<std::function<void()>>& runs, int warmup = 2,
+                                                      int rounds = 10);
+
 // Median of a sample (the mean of the two middle values for an even count).
 double median(std::vector<double> values);
 

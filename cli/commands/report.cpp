@@ -52,7 +52,11 @@ void setup_report(CLI::App& app) {
 }
 
 nlohmann::ordered_json run_report(const ReportOptions& options, RunDir& run_dir) {
-  const auto tables = group_results(collect_evaluations(options.runs));
+  return write_report(collect_evaluations(options.runs), run_dir);
+}
+
+nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir) {
+  const auto tables = group_results(evaluations);
   std::string markdown;
   nlohmann::ordered_json results;
   results["tables"] = nlohmann::ordered_json::array();
@@ -66,6 +70,8 @@ nlohmann::ordered_json run_report(const ReportOptions& options, RunDir& run_dir)
   write_file_atomic(run_dir.file("report.md"), markdown);
   write_file_atomic(run_dir.file("report.csv"), report_csv(tables));
   std::printf("%s", markdown.c_str());
+  results["evaluations"] = nlohmann::ordered_json::array();
+  for (const auto& e : evaluations) results["evaluations"].push_back(to_json(e));
   return results;
 }
 

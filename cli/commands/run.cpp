@@ -16,9 +16,12 @@
 #include "cli/stage_cache.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/timing.h"
 #include "core/yaml_json.h"
 #include "export/exporter.h"
+#include "models/model_file.h"
 #include "render_data/dataset.h"
+#include "render_data/patch_sampler.h"
 
 namespace fs = std::filesystem;
 
@@ -306,22 +309,53 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
                                     [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
   record("eval", evaluated);
 
-  // report: one table and plot from both evaluations, then the verdict
-  ReportOptions report;
-  report.runs = {(stages.dir("eval") / "results.json").string(), (stages.dir("prune") / "results.json").string()};
-  const auto reported = stages.run("report", YAML::Node(report.runs), {evaluated.hash, pruned.hash},
-                                   [&](RunDir& dir, bool) { return run_report(report, dir); });
+  // report: one table and plot of every model. The stages timed their models minutes or hours
+  // apart, under whatever else the machine was doing then; the report times them again side by
+  // side, in interleaved rounds on one test frame, so that their latencies compare.
+  const std::string searched_name = pruned.summary.at("name").get<std::string>();
+  const std::map<std::string, fs::path> model_files = {
+      {trained.summary.at("name").get<std::string>(), backbone_file},
+      {enhance.summary.at("name").get<std::string>(), enhanced_file},
+      {searched_name, searched_file},
+      {searched_name + " MMP", stages.dir("prune") / "mmp.cgsr"},
+      {searched_name + " hybrid", pruned_file}};
+  const std::vector<std::string> runs = {(stages.dir("eval") / "results.json").string(),
+                                         (stages.dir("prune") / "results.json").string()};
+  const auto reported = stages.run(
+      "report", YAML::Node(runs), {evaluated.hash, pruned.hash}, [&](RunDir& dir, bool) {
+        std::vector<EvalResult> evaluations = collect_evaluations(runs);
+        if (eval.latency_runs > 0) {
+          std::vector<std::unique_ptr<Upscaler>> upscalers;
+          std::vector<Batch> frames;
+          std::vector<std::function<void()>> timed;
+          const int frame = data.frames(Split::Test).empty() ? 0 : data.frames(Split::Test).front();
+          for (const auto& e : evaluations) {
+            const auto file = model_files.find(e.name);
+            if (e.name == searched_name + " static")  // the static network inside the hybrid model file
+              upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(pruned_file).network));
+            else
+              upscalers.push_back(make_upscaler(file == model_files.end() ? e.name : file->second.string(), e.name,
+                                                backbone.scale));
+            frames.push_back(frame_batch(data, frame, backbone.scale, upscalers.back()->channels()));
+          }
+          for (size_t i = 0; i < upscalers.size(); ++i)
+            timed.push_back([&, i] { upscalers[i]->upscale(frames[i]); });
+          spdlog::info("timing {} models side by side ({} interleaved rounds)", timed.size(), eval.latency_runs);
+          const auto latency = measure_latency_interleaved(timed, /*warmup=*/2, eval.latency_runs);
+          for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
+        }
+        return write_report(evaluations, dir);
+      });
   record("report", reported);
   if (reported.skipped) std::printf("%s", read_file(stages.dir("report") / "report.md").c_str());
 
-  const std::vector<EvalResult> evaluations = collect_evaluations(report.runs);
-  const std::string searched_name = searched.summary.at("name").get<std::string>();
+  const std::vector<EvalResult> evaluations = collect_evaluations({(stages.dir("report") / "results.json").string()});
   PipelineResults roles;
   roles.bicubic = find_result(evaluations, "bicubic");
   roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
   roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
-  roles.cg_optimized = find_result(evaluations, pruned.summary.at("name").get<std::string>());
-  roles.pruned = find_result(evaluations, pruned.summary.at("name").get<std::string>() + " hybrid");
+  roles.cg_optimized = find_result(evaluations, searched_name);
+  roles.pruned = find_result(evaluations, searched_name + " hybrid");
   if (!roles.bicubic || !roles.backbone || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
     throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + searched_name + ")",
                 ErrorKind::Internal);

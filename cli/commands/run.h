@@ -8,7 +8,8 @@
 //   prune    hybrid pruning + magnitude baseline              DIR/prune
 //   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
 //   eval     classic baselines, backbone and CG-enhanced on the test split          DIR/eval
-//   report   table, plot and verdict                          DIR/report.md, DIR/verdict.txt
+//   report   every model timed again side by side; table, plot  DIR/report/report.md
+//            and the verdict (cli/pipeline_verdict.h)             DIR/verdict.txt
 //
 // Each stage's section is the config of the matching subcommand (cgsr train, cgsr search, ...)
 // without the paths, which the pipeline fills in. A stage directory records the hash of its
