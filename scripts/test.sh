@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The whole test suite, as CI runs it (after scripts/install-deps.sh):
-#   1. the Release build in build/ and every test (ctest);
-#   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer in build-asan/,
-#      minus the end-to-end tests labelled `slow` (they train networks; ASan makes them several
-#      times slower, and the code they run is covered by the unit tests it does run).
+# The whole test suite, as CI runs it (after scripts/install-deps.sh): the Release build in
+# build/ and every test (ctest).
+#   --with-sanitizers  then also the suite built with AddressSanitizer + UndefinedBehaviorSanitizer
+#                      in build-asan/, minus the end-to-end tests labelled `slow` (they train
+#                      networks, which ASan makes several times slower; the unit tests it runs
+#                      cover the same code). A second full build: about 40 minutes on 2 cores.
 # Each step stops the script on failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,8 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build
 ctest --test-dir build --output-on-failure -j"$jobs"
 
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DCGSR_SANITIZE=ON -DCGSR_BUILD_BENCH=OFF
-cmake --build build-asan
-ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE slow
+if [ "${1:-}" = "--with-sanitizers" ]; then
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DCGSR_SANITIZE=ON -DCGSR_BUILD_BENCH=OFF
+  cmake --build build-asan
+  ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE slow
+fi
