@@ -49,33 +49,6 @@ TrainOutput SRNetworkImpl::forward_train(const torch::Tensor& lr_color, const to
   return {recon.image, has_geometry_head() ? geometry_->forward(recon.hr_features) : torch::Tensor()};
 }
 
-namespace {
-// The rows of `info` (stacked in `available` order) holding `wanted`, in `wanted` order.
-torch::Tensor select_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
-                              const std::vector<RenderChannel>& wanted, const std::string& what) {
-  if (!info.defined() || info.dim() != 4 || info.size(1) != total_width(available))
-    throw Error("batch", what + " must be [N, " + std::to_string(total_width(available)) + ", H, W] for channels " +
-                             join(channel_names(available)) + ", got " +
-                             (info.defined() ? shape_string(info) : std::string("nothing")));
-  std::vector<torch::Tensor> parts;
-  for (auto c : wanted) {
-    int64_t offset = 0;
-    bool found = false;
-    for (auto a : available) {
-      if (a == c) {
-        found = true;
-        break;
-      }
-      offset += channel_width(a);
-    }
-    if (!found)
-      throw Error("batch", "the model needs rendering channel '" + channel_name(c) + "' but the batch has only " +
-                               (available.empty() ? std::string("none") : join(channel_names(available))));
-    parts.push_back(info.slice(1, offset, offset + channel_width(c)));
-  }
-  return torch::cat(parts, 1);
-}
-}  // namespace
 
 torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
   if (!has_rit()) return {};
@@ -83,13 +56,13 @@ torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
     throw Error("batch", "scale x" + std::to_string(batch.scale) + " does not match the model's x" +
                              std::to_string(spec_.scale));
   const bool hr = spec_.rit.source == "hr_pooled";
-  return select_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
-                         hr ? "hr_info" : "lr_info");
+  return pick_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
+                       hr ? "hr_info" : "lr_info", "the model");
 }
 
 torch::Tensor SRNetworkImpl::geometry_target(const Batch& batch) const {
   if (!has_geometry_head()) return {};
-  return select_channels(batch.hr_info, batch.channels, input_channels(), "hr_info");
+  return pick_channels(batch.hr_info, batch.channels, input_channels(), "hr_info", "the model");
 }
 
 graph::Graph SRNetworkImpl::describe(bool training) const {

@@ -5,34 +5,9 @@
 #include <algorithm>
 
 #include "core/error.h"
-#include "core/text.h"
 
 namespace cgsr {
 
-namespace {
-// Rows of `info` (stacked in `available` order) holding `wanted`, in `wanted` order.
-torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
-                            const std::vector<RenderChannel>& wanted) {
-  std::vector<torch::Tensor> parts;
-  for (auto c : wanted) {
-    int64_t offset = 0;
-    bool found = false;
-    for (auto a : available) {
-      if (a == c) {
-        found = true;
-        break;
-      }
-      offset += channel_width(a);
-    }
-    if (!found || !info.defined())
-      throw Error("batch", "the dynamic samplers need rendering channel '" + channel_name(c) +
-                               "' but the batch has only " +
-                               (available.empty() ? std::string("none") : join(channel_names(available))));
-    parts.push_back(info.slice(1, offset, offset + channel_width(c)));
-  }
-  return torch::cat(parts, 1);
-}
-}  // namespace
 
 HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std::move(name)), model_(std::move(model)) {
   model_.network->eval();
@@ -46,7 +21,7 @@ HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std:
 }
 
 torch::Tensor HybridUpscaler::sampler_info(const Batch& batch) const {
-  return pick_channels(batch.lr_info, batch.channels, sampler_channels_);
+  return pick_channels(batch.lr_info, batch.channels, sampler_channels_, "lr_info", "the dynamic samplers");
 }
 
 void HybridUpscaler::previous_frame(const Batch& previous) {

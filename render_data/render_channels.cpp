@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/tensor_checks.h"
 #include "core/text.h"
 
 namespace cgsr {
@@ -83,6 +84,32 @@ torch::Tensor linearize_depth(const torch::Tensor& normalized_depth, double near
   const double inv_near = 1.0 / near, inv_far = std::isinf(far) ? 0.0 : 1.0 / far;
   const auto inv_z = inv_near - normalized_depth.clamp(0.0, 1.0) * (inv_near - inv_far);
   return torch::reciprocal(inv_z.clamp_min(1e-30));
+}
+
+torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
+                            const std::vector<RenderChannel>& wanted, const std::string& what,
+                            const std::string& reader) {
+  if (!info.defined() || info.dim() != 4 || info.size(1) != total_width(available))
+    throw Error("batch", what + " must be [N, " + std::to_string(total_width(available)) + ", H, W] for channels " +
+                             join(channel_names(available)) + ", got " +
+                             (info.defined() ? shape_string(info) : std::string("nothing")));
+  std::vector<torch::Tensor> parts;
+  for (auto c : wanted) {
+    int64_t offset = 0;
+    bool found = false;
+    for (auto a : available) {
+      if (a == c) {
+        found = true;
+        break;
+      }
+      offset += channel_width(a);
+    }
+    if (!found)
+      throw Error("batch", reader + " needs rendering channel '" + channel_name(c) + "' but the batch has only " +
+                               (available.empty() ? std::string("none") : join(channel_names(available))));
+    parts.push_back(info.slice(1, offset, offset + channel_width(c)));
+  }
+  return torch::cat(parts, 1);
 }
 
 }  // namespace cgsr

@@ -33,6 +33,13 @@ int total_width(const std::vector<RenderChannel>& channels);
 std::vector<RenderChannel> parse_channels(const std::vector<std::string>& names);
 std::vector<std::string> channel_names(const std::vector<RenderChannel>& channels);
 
+// The rows of `info` ([N, total_width(available), H, W], channels stacked in `available` order)
+// that hold `wanted`, in `wanted` order. Errors name the tensor (`what`, e.g. "lr_info") and who
+// needs the channels (`reader`, e.g. "the model").
+torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderChannel>& available,
+                            const std::vector<RenderChannel>& wanted, const std::string& what,
+                            const std::string& reader);
+
 // The one place where linear view-space depth becomes what a network sees: the z-buffer value
 // of a perspective projection, (1/near - 1/z) / (1/near - 1/far), clamped to [0,1]. 0 at the near
 // plane, 1 at the far plane and beyond (sky, z = inf). Finite for any near > 0, far <= inf.
