@@ -7,7 +7,6 @@
 
 namespace cgsr {
 namespace {
-constexpr double kSlope = 0.2;
 }
 
 GeometryHeadImpl::GeometryHeadImpl(int64_t in_channels, int64_t width, const std::vector<RenderChannel>& channels)
@@ -17,12 +16,12 @@ GeometryHeadImpl::GeometryHeadImpl(int64_t in_channels, int64_t width, const std
 }
 
 torch::Tensor GeometryHeadImpl::forward(const torch::Tensor& hr_features) {
-  return conv2(torch::leaky_relu(conv1(hr_features), kSlope));
+  return conv2(torch::leaky_relu(conv1(hr_features), kLeakySlope));
 }
 
 int GeometryHeadImpl::describe(graph::Builder& g, int hr_features) const {
   const int h = g.leaky_relu(
-      describe_conv(g, "conv1", conv1, hr_features, graph::group_layout("geometry", conv1->weight.size(0))), kSlope);
+      describe_conv(g, "conv1", conv1, hr_features, graph::group_layout("geometry", conv1->weight.size(0))), kLeakySlope);
   return describe_conv(g, "conv2", conv2, h, info_layout(channels_));
 }
 

@@ -10,6 +10,9 @@
 
 namespace cgsr {
 
+// LeakyReLU slope of the PAN reference implementation, used by every block that activates.
+constexpr double kLeakySlope = 0.2;
+
 // A k x k convolution with zero "same" padding (k odd) and stride 1.
 torch::nn::Conv2d make_conv(int64_t in, int64_t out, int64_t kernel, bool bias = true);
 

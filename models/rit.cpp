@@ -7,7 +7,6 @@
 
 namespace cgsr {
 namespace {
-constexpr double kSlope = 0.2;
 }
 
 graph::Layout info_layout(const std::vector<RenderChannel>& channels) {
@@ -34,7 +33,7 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, std::string feature_gr
 torch::Tensor RitBlockImpl::forward(const torch::Tensor& features, const torch::Tensor& info) {
   auto x = pool_factor_ > 1 ? graph::apply_avg_pool(info, pool_factor_) : info;
   x = graph::apply_affine(x, gate, {});
-  x = torch::leaky_relu(conv(x), kSlope);
+  x = torch::leaky_relu(conv(x), kLeakySlope);
   if (upsample_factor_ > 1) x = graph::apply_resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
   return features + fuse(concat_ ? torch::cat({features, x}, 1) : x);
 }
@@ -42,7 +41,7 @@ torch::Tensor RitBlockImpl::forward(const torch::Tensor& features, const torch::
 int RitBlockImpl::describe(graph::Builder& g, int features, int info) const {
   int x = pool_factor_ > 1 ? g.avg_pool(info, pool_factor_) : info;
   x = g.affine("gate", x, gate, {}, /*trainable=*/true);
-  x = g.leaky_relu(describe_conv(g, "conv", conv, x, graph::group_layout("rit", conv->weight.size(0))), kSlope);
+  x = g.leaky_relu(describe_conv(g, "conv", conv, x, graph::group_layout("rit", conv->weight.size(0))), kLeakySlope);
   if (upsample_factor_ > 1) x = g.resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
   const int fused = describe_conv(g, "fuse", fuse, concat_ ? g.concat({features, x}) : x, g.value(features).layout);
   return g.add(features, fused);

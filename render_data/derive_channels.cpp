@@ -10,7 +10,6 @@
 
 namespace cgsr {
 namespace {
-constexpr double kPi = 3.14159265358979;
 
 // Pixel-to-view-space mapping of a pinhole camera: view ray (u, v, -1) * depth.
 struct Pinhole {

@@ -7,6 +7,10 @@
 
 namespace cgsr {
 
+constexpr double kPi = 3.14159265358979323846;
+constexpr float kPiF = static_cast<float>(kPi);
+constexpr float kTwoPiF = static_cast<float>(2 * kPi);
+
 struct Vec2 {
   float x = 0, y = 0;
 };

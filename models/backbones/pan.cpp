@@ -4,9 +4,8 @@
 
 namespace cgsr {
 namespace {
-constexpr double kSlope = 0.2;  // LeakyReLU slope of the reference implementation
 
-torch::Tensor lrelu(const torch::Tensor& x) { return torch::leaky_relu(x, kSlope); }
+torch::Tensor lrelu(const torch::Tensor& x) { return torch::leaky_relu(x, kLeakySlope); }
 
 const std::vector<std::string>& block_suffixes() {
   static const std::vector<std::string> s = {"a", "a_out", "b", "att", "b_out"};
@@ -92,14 +91,14 @@ int ScpaBlockImpl::describe(graph::Builder& g, int x) const {
   const auto group = [&](const char* suffix) { return block_group(index_, suffix); };
   const auto width = [](const torch::nn::Conv2d& c) { return c->weight.size(0); };
   auto scope = g.scope("blocks." + std::to_string(index_));
-  int a = g.leaky_relu(describe_conv(g, "conv1_a", conv1_a, x, graph::group_layout(group("a"), width(conv1_a))), kSlope);
-  int b = g.leaky_relu(describe_conv(g, "conv1_b", conv1_b, x, graph::group_layout(group("b"), width(conv1_b))), kSlope);
-  a = g.leaky_relu(describe_conv(g, "k1", k1, a, graph::group_layout(group("a_out"), width(k1))), kSlope);
+  int a = g.leaky_relu(describe_conv(g, "conv1_a", conv1_a, x, graph::group_layout(group("a"), width(conv1_a))), kLeakySlope);
+  int b = g.leaky_relu(describe_conv(g, "conv1_b", conv1_b, x, graph::group_layout(group("b"), width(conv1_b))), kLeakySlope);
+  a = g.leaky_relu(describe_conv(g, "k1", k1, a, graph::group_layout(group("a_out"), width(k1))), kLeakySlope);
   {
     auto pa_scope = g.scope("pa_conv");
     b = pa_conv->describe(g, b, group("att"), group("b_out"));
   }
-  b = g.leaky_relu(b, kSlope);
+  b = g.leaky_relu(b, kLeakySlope);
   const int out = describe_conv(g, "conv3", conv3, g.concat({a, b}), g.value(x).layout);
   return g.add(out, x);
 }
@@ -177,8 +176,8 @@ ReconstructionPorts PanImpl::describe_reconstruct(graph::Builder& g, int feature
       auto scope = g.scope(att_name);
       y = att->describe(g, y, up_group);
     }
-    y = g.leaky_relu(y, kSlope);
-    return g.leaky_relu(describe_conv(g, hr_name, hr, y, graph::group_layout(hr_group, hr->weight.size(0))), kSlope);
+    y = g.leaky_relu(y, kLeakySlope);
+    return g.leaky_relu(describe_conv(g, hr_name, hr, y, graph::group_layout(hr_group, hr->weight.size(0))), kLeakySlope);
   };
   int fea = stage(features, "upconv1", upconv1, "att1", att1, "hr_conv1", hr_conv1, "up1", "hr1");
   if (stages_ == 2) fea = stage(fea, "upconv2", upconv2, "att2", att2, "hr_conv2", hr_conv2, "up2", "hr2");

@@ -2,11 +2,9 @@
 
 #include <cmath>
 
+#include "render_data/vec_math.h"
+
 namespace cgsr {
-namespace {
-constexpr float kTwoPi = 6.28318530718f;
-constexpr float kPi = 3.14159265359f;
-}  // namespace
 
 void perpendicular_basis(Vec3 axis, Vec3& u, Vec3& v) {
   const Vec3 helper = std::abs(axis.y) < 0.9f ? Vec3{0, 1, 0} : Vec3{1, 0, 0};
@@ -75,10 +73,10 @@ void MeshBuilder::cylinder(Vec3 base, Vec3 axis, float radius, int segments, flo
   const Vec3 a = axis / len;
   Vec3 u, v;
   perpendicular_basis(a, u, v);
-  const float circumference = kTwoPi * radius * uv_per_metre;
+  const float circumference = kTwoPiF * radius * uv_per_metre;
   const uint32_t first = static_cast<uint32_t>(mesh_.positions.size());
   for (int s = 0; s <= segments; ++s) {
-    const float t = kTwoPi * s / segments;
+    const float t = kTwoPiF * s / segments;
     const Vec3 n = u * std::cos(t) + v * std::sin(t);
     vertex(base + n * radius, n, {circumference * s / segments, len * uv_per_metre});
     vertex(base + axis + n * radius, n, {circumference * s / segments, 0});
@@ -95,7 +93,7 @@ void MeshBuilder::cylinder(Vec3 base, Vec3 axis, float radius, int segments, flo
     const uint32_t c = vertex(centre, n, {0.5f, 0.5f});
     const uint32_t ring = static_cast<uint32_t>(mesh_.positions.size());
     for (int s = 0; s < segments; ++s) {
-      const float t = kTwoPi * s / segments;
+      const float t = kTwoPiF * s / segments;
       const Vec3 d = u * std::cos(t) + v * std::sin(t);
       vertex(centre + d * radius, n, {0.5f + 0.5f * std::cos(t), 0.5f + 0.5f * std::sin(t)});
     }
@@ -110,9 +108,9 @@ void MeshBuilder::cylinder(Vec3 base, Vec3 axis, float radius, int segments, flo
 void MeshBuilder::sphere(Vec3 centre, float radius, int rings, int segments, float uv_repeats) {
   const uint32_t first = static_cast<uint32_t>(mesh_.positions.size());
   for (int r = 0; r <= rings; ++r) {
-    const float phi = kPi * r / rings;  // 0 at the top
+    const float phi = kPiF * r / rings;  // 0 at the top
     for (int s = 0; s <= segments; ++s) {
-      const float theta = kTwoPi * s / segments;
+      const float theta = kTwoPiF * s / segments;
       const Vec3 n{std::sin(phi) * std::cos(theta), std::cos(phi), -std::sin(phi) * std::sin(theta)};
       vertex(centre + n * radius, n, {uv_repeats * 2 * s / segments, uv_repeats * static_cast<float>(r) / rings});
     }
@@ -133,10 +131,10 @@ void MeshBuilder::torus(Vec3 centre, Vec3 axis, float major, float minor, int ma
   perpendicular_basis(a, u, v);
   const uint32_t first = static_cast<uint32_t>(mesh_.positions.size());
   for (int i = 0; i <= major_segments; ++i) {
-    const float t = kTwoPi * i / major_segments;
+    const float t = kTwoPiF * i / major_segments;
     const Vec3 radial = u * std::cos(t) + v * std::sin(t);
     for (int j = 0; j <= minor_segments; ++j) {
-      const float p = kTwoPi * j / minor_segments;
+      const float p = kTwoPiF * j / minor_segments;
       const Vec3 n = radial * std::cos(p) + a * std::sin(p);
       vertex(centre + radial * major + n * minor, n,
              {uv_repeats * 4 * i / major_segments, uv_repeats * static_cast<float>(j) / minor_segments});
@@ -164,7 +162,7 @@ void MeshBuilder::tube(const std::vector<Vec3>& path, float radius, int segments
     u = normalize(u - dir * dot(u, dir));
     v = cross(dir, u);
     for (int s = 0; s <= segments; ++s) {
-      const float t = kTwoPi * s / segments;
+      const float t = kTwoPiF * s / segments;
       const Vec3 n = u * std::cos(t) + v * std::sin(t);
       vertex(path[k] + n * radius, n, {static_cast<float>(s) / segments, along * uv_per_metre});
     }

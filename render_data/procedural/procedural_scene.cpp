@@ -10,11 +10,11 @@
 #include "render_data/procedural/mesh_builder.h"
 #include "render_data/procedural/procedural_textures.h"
 #include "render_data/scene_source.h"
+#include "render_data/vec_math.h"
 
 namespace cgsr {
 namespace {
 
-constexpr float kPi = 3.14159265359f;
 
 class Rng {
  public:
@@ -273,7 +273,7 @@ class LevelBuilder {
     CameraPath path;
     path.near_plane = cam.near_plane;
     path.far_plane = cam.far_plane;
-    const float phase_yaw = rng_.range(0, 2 * kPi), phase_pitch = rng_.range(0, 2 * kPi), phase_roll = rng_.range(0, 2 * kPi);
+    const float phase_yaw = rng_.range(0, 2 * kPiF), phase_pitch = rng_.range(0, 2 * kPiF), phase_roll = rng_.range(0, 2 * kPiF);
     std::vector<Vec3> points;
     for (const auto& [x, z] : walk) {
       const float j = 0.12f * grid_.cell;
@@ -284,7 +284,7 @@ class LevelBuilder {
     float previous_yaw = 0;
     for (size_t k = 0; k < points.size(); ++k) {
       const Vec3 ahead = points[std::min(k + 1, points.size() - 1)] - points[k > 0 ? k - 1 : 0];
-      float heading = std::atan2(-ahead.x, -ahead.z) * 180.0f / kPi;  // yaw that looks along `ahead`
+      float heading = std::atan2(-ahead.x, -ahead.z) * 180.0f / kPiF;  // yaw that looks along `ahead`
       if (k > 0) {  // unwrap: the path's yaw values are continuous
         while (heading - previous_yaw > 180) heading -= 360;
         while (heading - previous_yaw < -180) heading += 360;
@@ -386,7 +386,7 @@ class LevelBuilder {
         MeshBuilder b("crate", mat, object());
         float s = rng_.range(0.5f, 0.95f), y = 0;
         for (int level = 0; level < (rng_.chance(0.35) ? 2 : 1); ++level) {
-          const float yaw = rng_.range(0, kPi / 2);
+          const float yaw = rng_.range(0, kPiF / 2);
           const Vec3 ax{std::cos(yaw), 0, -std::sin(yaw)}, az{std::sin(yaw), 0, std::cos(yaw)};
           b.oriented_box(grid_.centre(x, z, y + s / 2) + Vec3{rng_.range(-0.1f, 0.1f) * c, 0, rng_.range(-0.1f, 0.1f) * c},
                          ax, {0, 1, 0}, az, {s / 2, s / 2, s / 2}, 1.0f / s);
@@ -430,7 +430,7 @@ class LevelBuilder {
       const int mat = material(TextureKind::Stripes, {0.85f, 0.7f, 0.1f}, {0.1f, 0.1f, 0.1f}, 0.7f, 96);
       for (int i = 0; i < p.tori && take_cell(x, z); ++i) {
         const float major = rng_.range(0.4f, 0.6f), minor = rng_.range(0.07f, 0.13f);
-        const float yaw = rng_.range(0, kPi);
+        const float yaw = rng_.range(0, kPiF);
         MeshBuilder b("torus", mat, object());
         if (rng_.chance(0.6)) b.torus(grid_.centre(x, z, major + minor), {std::cos(yaw), 0, std::sin(yaw)}, major, minor, 40, 14, 1.0f);
         else b.torus(grid_.centre(x, z, 1.2f), {0.2f, 1, 0.1f}, major, minor, 40, 14, 1.0f);

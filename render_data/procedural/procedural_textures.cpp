@@ -5,11 +5,10 @@
 
 #include "core/error.h"
 #include "core/text.h"
+#include "render_data/vec_math.h"
 
 namespace cgsr {
 namespace {
-
-constexpr float kTwoPi = 6.28318530718f;
 
 uint64_t mix64(uint64_t x) {
   x += 0x9E3779B97F4A7C15ULL;
@@ -142,7 +141,7 @@ Texture make_texture(TextureKind kind, int size, uint64_t seed, Vec3 base, Vec3 
           const int joint = static_cast<int>(hash01(plank, 7, seed) * N);
           const bool seam = (x % pw) < line || positive_mod(y - joint, N) < line;
           // Grain: stripes along y, bent by noise; an integer number of periods across N.
-          const float grain = 0.5f + 0.5f * std::sin(kTwoPi * (x * 12.0f / N + 0.6f * noise(x, y, 3)));
+          const float grain = 0.5f + 0.5f * std::sin(kTwoPiF * (x * 12.0f / N + 0.6f * noise(x, y, 3)));
           const float shade = 0.8f + 0.35f * hash01(plank, positive_mod(y - joint, N) < N / 2, seed + 1);
           const Vec3 c = seam ? accent * 0.5f : lerp(base, accent, 0.35f * grain) * shade;
           canvas.set(x, y, clamp01(c));

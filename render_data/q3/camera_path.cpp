@@ -9,12 +9,12 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "render_data/vec_math.h"
 
 namespace cgsr::q3 {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
-constexpr float kDeg = 180.0f / kPi;
+constexpr float kDeg = 180.0f / kPiF;
 const Vec3 kPlayerHalf{15, 15, 24};  // the player's box around its origin (24 above the floor)
 
 struct Node {
@@ -262,7 +262,7 @@ std::vector<Vec3> shorten(const std::vector<Node>& nodes, const std::vector<int>
 }
 
 // One span of a centripetal Catmull-Rom spline as a cubic Hermite curve, tangents scaled.
-struct Span {
+struct CurveSegment {
   Vec3 p0, p1, m0, m1;
   Vec3 at(float s) const {
     const float s2 = s * s, s3 = s2 * s;
@@ -270,7 +270,7 @@ struct Span {
   }
 };
 
-Span centripetal_span(const std::vector<Vec3>& p, size_t i) {
+CurveSegment centripetal_span(const std::vector<Vec3>& p, size_t i) {
   const size_t n = p.size();
   auto knot = [](Vec3 a, Vec3 b) { return std::max(1e-3f, std::sqrt(length(b - a))); };
   const Vec3 a = p[i], b = p[i + 1];
@@ -371,8 +371,8 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
     if (nodes[i].spawn) spawns.push_back(static_cast<int>(i));
   const std::vector<int> pool = spawns.empty() ? std::vector<int>{0} : spawns;
   const int start = pool[std::uniform_int_distribution<size_t>(0, pool.size() - 1)(rng)];
-  const float phase_yaw = std::uniform_real_distribution<float>(0, 2 * kPi)(rng);
-  const float phase_pitch = std::uniform_real_distribution<float>(0, 2 * kPi)(rng);
+  const float phase_yaw = std::uniform_real_distribution<float>(0, 2 * kPiF)(rng);
+  const float phase_pitch = std::uniform_real_distribution<float>(0, 2 * kPiF)(rng);
 
   add_navigation_nodes(collision.bsp(), placer, o, nodes, report);
   const Clearance clear(collision, obstacles, o);
@@ -383,9 +383,9 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
   // Dense polyline along the verified spline.
   std::vector<Vec3> line{eyes.front()};
   for (size_t i = 0; i + 1 < eyes.size(); ++i) {
-    const Span full = centripetal_span(eyes, i);
+    const CurveSegment full = centripetal_span(eyes, i);
     for (float scale : {1.0f, 0.5f, 0.0f}) {
-      const Span span{full.p0, full.p1, full.m0 * scale, full.m1 * scale};
+      const CurveSegment span{full.p0, full.p1, full.m0 * scale, full.m1 * scale};
       const float chord = length(span.p1 - span.p0);
       const int steps = std::max(1, static_cast<int>(std::ceil(chord / o.key_spacing)));
       std::vector<Vec3> samples;
@@ -414,7 +414,7 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
     for (int k = 0; k < keys; ++k) {
       const float t = static_cast<float>(k) / (keys - 1);
       path.keys.push_back({line.front(), 360.0f * t,
-                           o.pitch_sway_degrees * std::sin(2 * kPi * t + phase_pitch), static_cast<double>(k)});
+                           o.pitch_sway_degrees * std::sin(2 * kPiF * t + phase_pitch), static_cast<double>(k)});
     }
     return path;
   }
@@ -468,8 +468,8 @@ QuakeCameraPath build_camera_path(const std::vector<Entity>& entities, const Bsp
     QuakeCameraKey key;
     key.position = positions[k];
     key.distance = k * spacing;
-    key.yaw = yaw + o.yaw_sway_degrees * std::sin(2 * kPi * s / o.yaw_sway_period + phase_yaw);
-    key.pitch = std::clamp(pitch + o.pitch_sway_degrees * std::sin(2 * kPi * s / o.pitch_sway_period + phase_pitch),
+    key.yaw = yaw + o.yaw_sway_degrees * std::sin(2 * kPiF * s / o.yaw_sway_period + phase_yaw);
+    key.pitch = std::clamp(pitch + o.pitch_sway_degrees * std::sin(2 * kPiF * s / o.pitch_sway_period + phase_pitch),
                            -o.max_pitch, o.max_pitch);
     path.keys.push_back(key);
   }
