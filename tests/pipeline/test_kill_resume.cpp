@@ -35,8 +35,6 @@ const std::string kSeed = "7";
 const std::string kThreads = "1";
 constexpr auto kTimeout = 120s;  // for the first checkpoint to appear (normally well under 5 s)
 
-nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(slurp(path)); }
-
 std::vector<std::string> with_run_flags(std::vector<std::string> args, const fs::path& out) {
   args.insert(args.end(), {"--out", out.string(), "--seed", kSeed, "--threads", kThreads});
   return args;

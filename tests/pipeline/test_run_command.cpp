@@ -51,8 +51,6 @@ fs::path write_config(const fs::path& dir) {
   return file;
 }
 
-nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(slurp(path)); }
-
 // Stage name -> "ran" / "skipped", from the log lines of one cgsr run.
 std::map<std::string, std::string> stage_actions(const std::string& log) {
   std::map<std::string, std::string> out;

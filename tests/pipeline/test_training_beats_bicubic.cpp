@@ -33,9 +33,7 @@ constexpr int kSteps = 2000;
 constexpr double kMarginDb = 0.5;  // required PSNR gain over bicubic on the test frames
 // One thread: these tiny batches gain nothing from a second thread, and on a loaded 2-core
 // machine two threads ran the training 2-3x slower than one.
-const std::string kThreads = "1";
-
-nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(slurp(path)); }
+const std::string kTrainingThreads = "1";
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -52,7 +50,7 @@ TEST(TrainingBeatsBicubic, PanX2OnASmallSceneBeatsBicubicOnTheTestFrames) {
   // and frames for a real test split, still rendered in about a second.
   auto r = run_cgsr_args({"render", "--config", source + "/configs/scenes/tiny.yaml", "--frames", "16",
                           "--resolutions", "[96x72, 192x144]", "--out", data.string(), "--seed",
-                          std::to_string(kSceneSeed), "--threads", kThreads},
+                          std::to_string(kSceneSeed), "--threads", kTrainingThreads},
                          dir / "render");
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
@@ -65,7 +63,7 @@ TEST(TrainingBeatsBicubic, PanX2OnASmallSceneBeatsBicubicOnTheTestFrames) {
                      "--model", spec.string(), "--steps", std::to_string(kSteps), "--set", "schedule.batch_size=2",
                      "--set", "schedule.patch_size=16", "--set", "schedule.lr_max=2e-3", "--set",
                      "schedule.checkpoint_every=1000", "--out", train.string(), "--seed", std::to_string(kTrainSeed),
-                     "--threads", kThreads},
+                     "--threads", kTrainingThreads},
                     dir / "train");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const double train_seconds = seconds_since(train_started);
@@ -95,7 +93,7 @@ TEST(TrainingBeatsBicubic, PanX2OnASmallSceneBeatsBicubicOnTheTestFrames) {
 
   r = run_cgsr_args({"eval", "--data", data.string(), "--model", (train / "model.cgsr").string(), "--model", "bicubic",
                      "--split", "test", "--set", "eval.latency_runs=0", "--set", "eval.temporal=false", "--out",
-                     eval.string(), "--threads", kThreads},
+                     eval.string(), "--threads", kTrainingThreads},
                     dir / "eval");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto evaluated = read_json(eval / "results.json");

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace cgsr::test {
 
 struct CliResult {
@@ -23,6 +25,8 @@ inline std::string slurp(const std::filesystem::path& path) {
   s << in.rdbuf();
   return s.str();
 }
+
+inline nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(slurp(path)); }
 
 // A fresh directory under the system temp dir, unique per process and name.
 inline std::filesystem::path scratch_dir(const std::string& name) {
