@@ -72,7 +72,7 @@ TEST(Rit, JointLossGradientsReachGateAndImportances) {
                     importance.at("block0_a").index_select(0, torch::tensor({0, 3})).sum();
   loss.backward();
   EXPECT_GT(net->rit_gate().grad().abs().sum().item<float>(), 0.f);
-  const auto& k = net->named_parameters()["backbone.blocks.0.conv1_a.weight"];
+  const torch::Tensor k = net->named_parameters()["backbone.blocks.0.conv1_a.weight"];
   ASSERT_TRUE(k.grad().defined());
   EXPECT_GT(k.grad()[0].abs().sum().item<float>(), 0.f);
 }
