@@ -153,6 +153,7 @@ DatasetManifest read_manifest(const fs::path& root) {
   const auto doc = config::Document::load_file(path);
   const YAML::Node& n = doc.root();
   const config::Cursor at{&doc, ""};
+  if (!n.IsMap()) at.fail(n, "expected a map of keys, got " + config::detail::describe(n));
   auto need = [&](const char* key) {
     if (!n[key]) at.child(key).fail(n, std::string("missing required key '") + key + "'");
     return n[key];
@@ -178,6 +179,7 @@ DatasetManifest read_manifest(const fs::path& root) {
   if (n["seed"]) m.seed = config::Codec<uint64_t>::decode(n["seed"], at.child("seed"));
   const YAML::Node split = need("split");
   const config::Cursor sat = at.child("split");
+  if (!split.IsMap()) sat.fail(split, "expected a map of train, val and test frames, got " + config::detail::describe(split));
   for (Split s : {Split::Train, Split::Val, Split::Test}) {
     const auto key = split_name(s);
     if (!split[key]) sat.child(key).fail(split, "missing required key '" + key + "'");
@@ -186,9 +188,12 @@ DatasetManifest read_manifest(const fs::path& root) {
     for (int f : list)
       if (f < 0 || f >= m.frames) sat.child(key).fail(split[key], "frame " + std::to_string(f) + " out of range");
   }
-  if (const YAML::Node bytes = n["bytes_per_frame"])
+  if (const YAML::Node bytes = n["bytes_per_frame"]) {
+    const config::Cursor bat = at.child("bytes_per_frame");
+    if (!bytes.IsMap()) bat.fail(bytes, "expected a map from resolution to bytes, got " + config::detail::describe(bytes));
     for (const auto& r : m.resolutions)
-      m.bytes_per_frame.push_back(bytes[r.name()] ? bytes[r.name()].as<double>() : 0.0);
+      m.bytes_per_frame.push_back(bytes[r.name()] ? config::Codec<double>::decode(bytes[r.name()], bat.child(r.name())) : 0.0);
+  }
   for (size_t i = 1; i < m.resolutions.size(); ++i)
     if (m.resolutions[i].width <= m.resolutions[i - 1].width)
       at.child("resolutions").fail(n["resolutions"], "resolutions must be listed in ascending order");
