@@ -2,6 +2,7 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cstring>
 #include <set>
 #include <fstream>
@@ -19,15 +20,6 @@ constexpr char kMagic[8] = {'C', 'G', 'S', 'R', 'M', 'O', 'D', 'L'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeaderSize = 8 + 4 + 8 + 8;
 constexpr size_t kChecksumSize = 8;
-
-uint64_t fnv1a64(const char* data, size_t size) {
-  uint64_t h = 1469598103934665603ull;
-  for (size_t i = 0; i < size; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ull;
-  }
-  return h;
-}
 
 template <class T>
 void put_le(std::string& out, T value) {
@@ -48,6 +40,15 @@ std::string shape_of(const std::vector<int64_t>& sizes) {
 }
 
 }  // namespace
+
+uint64_t model_file_checksum(std::string_view bytes) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a, 64 bit
+  for (const char c : bytes) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
 
 nlohmann::ordered_json to_json(const Provenance& p) {
   nlohmann::ordered_json j;
@@ -99,7 +100,7 @@ void write_model_file(const std::filesystem::path& path, const ModelFileContents
   put_le<uint64_t>(file, weight_bytes.size());
   file += meta_text;
   file += weight_bytes;
-  put_le<uint64_t>(file, fnv1a64(file.data(), file.size()));
+  put_le<uint64_t>(file, model_file_checksum(file));
   write_file_atomic(path, file);
 }
 
@@ -124,7 +125,7 @@ ModelFileContents read_model_file(const std::filesystem::path& path) {
   const size_t body = kHeaderSize + meta_size + weight_size;
   if (body + kChecksumSize != file.size())
     throw Error(where, std::to_string(file.size() - body - kChecksumSize) + " unexpected bytes after the model data");
-  if (get_le<uint64_t>(file, body) != fnv1a64(file.data(), body))
+  if (get_le<uint64_t>(file, body) != model_file_checksum(std::string_view(file).substr(0, body)))
     throw Error(where, "corrupted model file (checksum mismatch)");
 
   nlohmann::ordered_json meta;
@@ -150,6 +151,8 @@ ModelFileContents read_model_file(const std::filesystem::path& path) {
     torch::load(values, in);
   } catch (const c10::Error& e) {
     throw Error(where, "unreadable weights: " + std::string(e.what_without_backtrace()));
+  } catch (const std::exception& e) {  // the TorchScript deserializer also throws its own errors
+    throw Error(where, "unreadable weights: " + std::string(e.what()));
   }
   if (values.size() != declared.size())
     throw Error(where, "metadata lists " + std::to_string(declared.size()) + " tensors, the weights hold " +
@@ -161,8 +164,13 @@ ModelFileContents read_model_file(const std::filesystem::path& path) {
     contents.tensors.emplace_back(declared[i].first, values[i]);
   }
   const auto expected = channel_names(contents.spec.input_channels());
-  if (meta.contains("channels") && meta["channels"].get<std::vector<std::string>>() != expected)
-    throw Error(where, "metadata channels do not match the spec's rit.channels (" + join(expected) + ")");
+  if (meta.contains("channels")) {
+    const auto& channels = meta["channels"];
+    const bool strings = channels.is_array() && std::all_of(channels.begin(), channels.end(),
+                                                              [](const auto& c) { return c.is_string(); });
+    if (!strings || channels.get<std::vector<std::string>>() != expected)
+      throw Error(where, "metadata channels do not match the spec's rit.channels (" + join(expected) + ")");
+  }
   return contents;
 }
 

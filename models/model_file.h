@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,9 @@ struct ModelFileContents {
   Provenance provenance;
   std::vector<std::pair<std::string, torch::Tensor>> tensors;  // parameter name -> value
 };
+
+// The trailing checksum of a model file whose bytes before the checksum are `bytes`.
+uint64_t model_file_checksum(std::string_view bytes);
 
 void write_model_file(const std::filesystem::path& path, const ModelFileContents& contents);
 ModelFileContents read_model_file(const std::filesystem::path& path);
