@@ -9,6 +9,12 @@ function(cgsr_target_defaults target)
                                             -fno-omit-frame-pointer -g1)
     target_link_options(${target} PUBLIC -fsanitize=address,undefined)
   endif()
+  if(CGSR_FUZZ)
+    # Coverage for libFuzzer in every library; the fuzz targets add -fsanitize=fuzzer (main).
+    target_compile_options(${target} PUBLIC -fsanitize=fuzzer-no-link,address,undefined
+                                            -fno-sanitize-recover=all -fno-omit-frame-pointer -g1)
+    target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+  endif()
 endfunction()
 
 # Compiling <torch/torch.h> costs ~20 s per translation unit on this machine. The header is

@@ -2,7 +2,7 @@
 // tessellation, the collision tree, and the entity string. Every input must either parse or be
 // rejected with cgsr::Error; crashes, hangs and sanitizer reports are bugs.
 //
-//   cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCGSR_FUZZ=ON
+//   cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCGSR_FUZZ=ON -DCGSR_BUILD_TESTS=OFF -DCGSR_BUILD_BENCH=OFF
 //   cmake --build build-fuzz --target fuzz_bsp
 //   build-fuzz/fuzz/fuzz_bsp -max_total_time=300 -max_len=65536 <corpus dir>
 

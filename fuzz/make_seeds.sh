@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Regenerates the seed inputs in fuzz/corpus/ from what cgsr itself writes: the manifest and
+# the 64x48 files of frame 0 of configs/scenes/tiny.yaml, and a small CG-enhanced PAN model
+# file. Config seeds are the files in configs/ (the fuzz tests read them there).
+#   fuzz/make_seeds.sh [BUILD_DIR]     (default: build)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cgsr="${1:-build}/cgsr"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+"$cgsr" render --config configs/scenes/tiny.yaml --set frames=3 --out "$work/data" >/dev/null
+rm -rf fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file
+mkdir -p fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file
+cp "$work/data/manifest.yaml" fuzz/corpus/manifest/tiny_manifest.yaml
+
+# fuzz_frame_files reads the file kind from the first byte (FileKind order in dataset_manifest.h).
+kind_byte=0
+for kind in color depth normal normal_angle edge id motion; do
+  file="$(ls "$work/data/64x48/$kind/000000."*)"
+  { printf "\\$(printf %03o "$kind_byte")"; cat "$file"; } > "fuzz/corpus/frame_files/$kind.bin"
+  kind_byte=$((kind_byte + 1))
+done
+
+printf 'backbone: pan\nscale: 2\nblocks: 1\nwidths: {features: 8}\n' > "$work/spec.yaml"
+"$cgsr" train --data "$work/data" --model "$work/spec.yaml" --out "$work/train" --threads 1 \
+  --set enhance.enabled=true --set enhance.rit.width=4 --set enhance.geometry.enabled=false \
+  --set schedule.steps=2 --set schedule.batch_size=1 --set schedule.patch_size=16 \
+  --set schedule.validate_every=0 --set schedule.val_frames=1 >/dev/null
+cp "$work/train/model.cgsr" fuzz/corpus/model_file/pan_cg_tiny.cgsr
+ls -l fuzz/corpus/*
