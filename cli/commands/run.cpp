@@ -46,7 +46,7 @@ config::Schema<PipelineOptions> pipeline_schema() {
   s.block("prune", &PipelineOptions::prune, "cgsr prune config (model, data, eval filled in)");
   s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in")
       .one_of(export_format_names());
-  s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames, latency runs)");
+  s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames; latency_runs: rounds of the report's side-by-side timing)");
   s.section("verdict", &PipelineOptions::verdict, verdict_schema(), "what the run must show");
   s.field("from", &PipelineOptions::from, "rerun this stage and every later one").check(
       [](const std::string& v) {
@@ -218,9 +218,13 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   search_filled["parent"] = enhanced_file.string();
   SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
   const EvalOptions eval = parse_stage(options.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
+  // The stages that evaluate (prune, eval) leave latency out: the report stage times every model
+  // side by side, which is the only timing that compares, so timing them earlier would be wasted.
+  EvalOptions stage_eval = eval;
+  stage_eval.latency_runs = 0;
   YAML::Node prune_filled = YAML::Clone(with_data);
   prune_filled["model"] = searched_file.string();
-  prune_filled["eval"] = eval_schema_fields().emit(eval);
+  prune_filled["eval"] = eval_schema_fields().emit(stage_eval);
   PruneCommandOptions prune = parse_stage(options.prune, prune_command_schema(), prune_filled, "prune");
 
   // render
@@ -299,7 +303,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   evaluation.threads = options.threads;
   evaluation.data = data_path;
   evaluation.scale = backbone.scale;
-  evaluation.eval = eval;
+  evaluation.eval = stage_eval;
   evaluation.models = {"bicubic"};
   for (const auto& b : options.baselines)
     if (b != "bicubic") evaluation.models.push_back(b);
