@@ -14,16 +14,18 @@
 namespace cgsr::fuzz {
 
 inline const std::filesystem::path& scratch_dir() {
-  static const std::filesystem::path dir = [] {
-    const auto d = std::filesystem::temp_directory_path() / ("cgsr-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d);
+  // Never destroyed: the exit handler that removes the folder runs after static destructors.
+  static const std::filesystem::path* dir = [] {
+    const auto* d = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                              ("cgsr-fuzz-" + std::to_string(::getpid())));
+    std::filesystem::create_directories(*d);
     std::atexit([] {
       std::error_code ignored;
       std::filesystem::remove_all(scratch_dir(), ignored);
     });
     return d;
   }();
-  return dir;
+  return *dir;
 }
 
 // Writes `size` bytes to `relative` under the scratch directory (folders created) and returns the path.
