@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -37,6 +38,19 @@ constexpr auto kTimeout = 120s;  // for the first checkpoint to appear (normally
 
 std::vector<std::string> with_run_flags(std::vector<std::string> args, const fs::path& out) {
   args.insert(args.end(), {"--out", out.string(), "--seed", kSeed, "--threads", kThreads});
+  return args;
+}
+
+// Starts `args` (output captured under `log_dir`) and SIGKILLs it as soon as `written()` holds.
+// Fails when that does not happen in time, or when the run ends before the kill.
+void kill_when(const std::vector<std::string>& args, const fs::path& log_dir, const std::function<bool()>& written) {
+  CgsrProcess run(args, log_dir);
+  ASSERT_TRUE(run.wait_for(written, kTimeout)) << run.err();
+  ASSERT_TRUE(run.kill()) << "the run finished before it could be killed; lengthen its schedule";
+}
+
+std::vector<std::string> with_resume(std::vector<std::string> args) {
+  args.push_back("--resume");
   return args;
 }
 
@@ -146,17 +160,12 @@ TEST(KillResume, TrainResumesFromItsCheckpointToTheUninterruptedResult) {
   auto r = run_cgsr_args(with_run_flags(train, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  {
-    CgsrProcess run(with_run_flags(train, out), dir / "killed");
-    ASSERT_TRUE(run.wait_for([&] { return fs::exists(out / "checkpoint.pt"); }, kTimeout)) << run.err();
-    ASSERT_TRUE(run.kill()) << "the run finished before it could be killed; lengthen its schedule";
-  }
+  ASSERT_NO_FATAL_FAILURE(
+      kill_when(with_run_flags(train, out), dir / "killed", [&] { return fs::exists(out / "checkpoint.pt"); }));
   expect_killed_run_dir(out, {"model.cgsr", "last.cgsr"}, "] training ");
   EXPECT_TRUE(fs::exists(out / "checkpoint.pt"));
 
-  auto resume = with_run_flags(train, out);
-  resume.push_back("--resume");
-  r = run_cgsr_args(resume, dir / "resumed");
+  r = run_cgsr_args(with_resume(with_run_flags(train, out)), dir / "resumed");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // The checkpoint was read, not ignored: training went on from where it was killed.
   const int step = resumed_at(r.err);
@@ -199,23 +208,16 @@ final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(line_count(reference / "history.jsonl"), 7);
 
-  auto resume = with_run_flags(search, out);
-  resume.push_back("--resume");
+  const auto resume = with_resume(with_run_flags(search, out));
   // Killed during the candidates (after the parent and one candidate are recorded) ...
-  {
-    CgsrProcess run(with_run_flags(search, out), dir / "killed1");
-    ASSERT_TRUE(run.wait_for([&] { return line_count(out / "history.jsonl") >= 2; }, kTimeout)) << run.err();
-    ASSERT_TRUE(run.kill()) << "the search finished before it could be killed";
-  }
+  ASSERT_NO_FATAL_FAILURE(kill_when(with_run_flags(search, out), dir / "killed1",
+                                    [&] { return line_count(out / "history.jsonl") >= 2; }));
   expect_killed_run_dir(out, {"model.cgsr"}, "] search: parent ");
   EXPECT_LT(line_count(out / "history.jsonl"), 7);
   ASSERT_FALSE(fs::exists(out / "final_checkpoint.pt"));  // the next kill waits for it
   // ... then, resumed, killed again during the training of the pick ...
-  {
-    CgsrProcess run(resume, dir / "killed2");
-    ASSERT_TRUE(run.wait_for([&] { return fs::exists(out / "final_checkpoint.pt"); }, kTimeout)) << run.err();
-    ASSERT_TRUE(run.kill()) << "the final training finished before it could be killed";
-  }
+  ASSERT_NO_FATAL_FAILURE(
+      kill_when(resume, dir / "killed2", [&] { return fs::exists(out / "final_checkpoint.pt"); }));
   expect_killed_run_dir(out, {"model.cgsr"}, "] generation 1: ");
   EXPECT_EQ(line_count(out / "history.jsonl"), 7);
   // ... and resumed to the end.
@@ -275,16 +277,11 @@ TEST(KillResume, PruneResumesItsFineTuning) {
   auto r = run_cgsr_args(with_run_flags(prune, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
-  {
-    CgsrProcess run(with_run_flags(prune, out), dir / "killed");
-    ASSERT_TRUE(run.wait_for([&] { return fs::exists(out / "finetune_hybrid.pt"); }, kTimeout)) << run.err();
-    ASSERT_TRUE(run.kill()) << "pruning finished before it could be killed";
-  }
+  ASSERT_NO_FATAL_FAILURE(
+      kill_when(with_run_flags(prune, out), dir / "killed", [&] { return fs::exists(out / "finetune_hybrid.pt"); }));
   expect_killed_run_dir(out, {"pruned.cgsr", "mmp.cgsr"}, "] fine-tuning with dynamic patterns");
 
-  auto resume = with_run_flags(prune, out);
-  resume.push_back("--resume");
-  r = run_cgsr_args(resume, dir / "resumed");
+  r = run_cgsr_args(with_resume(with_run_flags(prune, out)), dir / "resumed");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const int step = resumed_at(r.err);
   EXPECT_GE(step, 5) << r.err;
