@@ -5,39 +5,36 @@
 #include "core/error.h"
 
 namespace cgsr {
-
-bool prefers_channels_last(const ArchSpec& spec) {
-  (void)spec;
-  return false;
+namespace {
+// The forward in one concrete layout; the weights stay as they are (LibTorch's convolutions
+// follow the activations' layout).
+torch::Tensor forward_in(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
+                         MemoryLayout layout) {
+  torch::NoGradGuard no_grad;
+  net.eval();
+  return net.forward(to_layout(lr_color, layout), to_layout(info, layout)).contiguous();
 }
+}  // namespace
 
-MemoryLayout memory_layout_from_name(const std::string& name) {
-  if (name == "auto") return MemoryLayout::Auto;
-  if (name == "nchw") return MemoryLayout::Nchw;
-  if (name == "nhwc") return MemoryLayout::Nhwc;
-  throw Error("memory layout", "'" + name + "' is not one of: auto, nchw, nhwc");
-}
-
-const char* memory_layout_name(MemoryLayout layout) {
-  switch (layout) {
-    case MemoryLayout::Auto: return "auto";
-    case MemoryLayout::Nchw: return "nchw";
-    case MemoryLayout::Nhwc: return "nhwc";
+MemoryLayout inference_layout(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
+                              MemoryLayout requested) {
+  if (requested != MemoryLayout::Auto) return requested;
+  CGSR_CHECK(lr_color.defined() && lr_color.dim() == 4, "inference_layout: colour must be [N, 3, h, w]");
+  const int64_t h = std::min<int64_t>(lr_color.size(2), 120), w = std::min<int64_t>(lr_color.size(3), 160);
+  const auto color = lr_color.slice(2, 0, h).slice(3, 0, w).contiguous();
+  torch::Tensor crop;
+  if (info.defined()) {
+    const int64_t f = info.size(2) / std::max<int64_t>(1, lr_color.size(2));
+    crop = info.slice(2, 0, h * f).slice(3, 0, w * f).contiguous();
   }
-  return "?";
+  const std::string key = "inference of " + spec_summary(net.spec()) + " on " + std::to_string(lr_color.size(0)) + "x" +
+                          std::to_string(w) + "x" + std::to_string(h);
+  return measured_layout(key, [&](MemoryLayout layout) { forward_in(net, color, crop, layout); });
 }
 
 torch::Tensor infer(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
                     MemoryLayout layout) {
-  torch::NoGradGuard no_grad;
-  net.eval();
-  const bool nhwc_layout =
-      layout == MemoryLayout::Nhwc || (layout == MemoryLayout::Auto && prefers_channels_last(net.spec()));
-  if (!nhwc_layout) return net.forward(lr_color, info);
-  const auto nhwc = [](const torch::Tensor& t) {
-    return t.defined() ? t.contiguous(torch::MemoryFormat::ChannelsLast) : t;
-  };
-  return net.forward(nhwc(lr_color), nhwc(info)).contiguous();
+  return forward_in(net, lr_color, info, inference_layout(net, lr_color, info, layout));
 }
 
 }  // namespace cgsr

@@ -1,26 +1,20 @@
 #pragma once
-// Running a trained network for inference: eval mode, no autograd, and the memory layout that
-// measured fastest for the backbone on this machine. Threads are the process-wide setting
-// (core/runtime.h set_threads, i.e. --threads).
+// Running a trained network for inference: eval mode, no autograd, and the memory layout
+// measured fastest for the network on this machine (memory_layout.h). Threads are the
+// process-wide setting (core/runtime.h set_threads, i.e. --threads).
 
 #include <torch/types.h>
 
-#include <string>
-
+#include "models/memory_layout.h"
 #include "models/sr_network.h"
 
 namespace cgsr {
 
-enum class MemoryLayout {
-  Auto,  // the layout measured fastest for the spec (prefers_channels_last)
-  Nchw,  // contiguous
-  Nhwc,  // channels-last activations
-};
-MemoryLayout memory_layout_from_name(const std::string& name);  // auto | nchw | nhwc
-const char* memory_layout_name(MemoryLayout layout);
-
-// Channels-last (NHWC) activations only where measured faster (see inference.cpp).
-bool prefers_channels_last(const ArchSpec& spec);
+// The layout infer() runs `net` in for inputs shaped like these: Nchw or Nhwc as requested; for
+// Auto, measured once per network and batch on a crop of at most 160x120 LR pixels (timing the
+// full size would cost more than it saves on 1080p frames) and remembered for the process.
+MemoryLayout inference_layout(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
+                              MemoryLayout requested = MemoryLayout::Auto);
 
 // [N, 3, s*h, s*w], contiguous NCHW. Puts the network in eval mode.
 torch::Tensor infer(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info = {},

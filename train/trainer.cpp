@@ -29,6 +29,9 @@ config::Schema<TrainSchedule> schedule_schema() {
   s.field("max_nonfinite_steps", &TrainSchedule::max_nonfinite_steps,
           "consecutive steps with a non-finite loss or gradient before training stops")
       .at_least(1);
+  s.field("layout", &TrainSchedule::layout,
+          "activation memory layout: auto measures both on the first batch and keeps the faster")
+      .one_of({"auto", "nchw", "nhwc"});
   s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
     if (t.lr_min > t.lr_max) at.child("lr_min").fail(node["lr_min"] ? node["lr_min"] : node, "must not exceed lr_max");
   });
@@ -51,6 +54,7 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
   j["seconds"] = o.seconds;
   j["patches_per_second"] = o.patches_per_second;
   j["resumed"] = o.resumed;
+  j["layout"] = o.layout;
   j["best"] = score(o.best);
   j["last"] = score(o.last);
   j["history"] = nlohmann::ordered_json::array();
@@ -85,6 +89,21 @@ std::string tensor_text(const torch::Tensor& t) {
   const auto c = t.contiguous();
   return std::string(reinterpret_cast<const char*>(c.data_ptr<uint8_t>()), static_cast<size_t>(c.numel()));
 }
+
+// The batch's tensors in `layout` (the loss and metrics are layout-agnostic).
+Batch in_layout(Batch b, MemoryLayout layout) {
+  b.lr_color = to_layout(b.lr_color, layout);
+  b.hr_color = to_layout(b.hr_color, layout);
+  b.lr_info = to_layout(b.lr_info, layout);
+  b.hr_info = to_layout(b.hr_info, layout);
+  return b;
+}
+
+// Hands the network back in NCHW however run() ends (DESIGN.md: NCHW in interfaces).
+struct NchwOnExit {
+  torch::nn::Module& module;
+  ~NchwOnExit() { set_parameter_layout(module, MemoryLayout::Nchw); }
+};
 
 // Frames spread evenly over `frames`, at most `count` (0 = all).
 std::vector<int> spread(const std::vector<int>& frames, int count) {
@@ -121,6 +140,26 @@ TrainOutput Trainer::forward(const Batch& batch, int step) {
   return network_->forward_train(batch.lr_color, network_->info_input(batch));
 }
 
+MemoryLayout Trainer::choose_layout(const Batch& batch) {
+  const MemoryLayout requested = memory_layout_from_name(schedule_.layout);
+  if (requested != MemoryLayout::Auto) return requested;
+  // Forward and backward without hooks or optimizer step: gradients are zeroed before every
+  // real step, so the measurement leaves nothing behind.
+  const auto shape = batch.lr_color.sizes();
+  const std::string key = "training of " + network_->spec().backbone + (network_->has_rit() ? " + RIT" : "") +
+                          " x" + std::to_string(network_->spec().scale) + " on " + std::to_string(shape[0]) + "x" +
+                          std::to_string(shape[3]) + "x" + std::to_string(shape[2]) + " patches";
+  const MemoryLayout chosen = measured_layout(key, [&](MemoryLayout layout) {
+    set_parameter_layout(*network_, layout);
+    const Batch b = in_layout(batch, layout);
+    const auto output = network_->forward_train(b.lr_color, network_->info_input(b));
+    cgsr_loss(*network_, output, b, loss_, shrink_).total.backward();
+    for (auto& p : network_->parameters())
+      if (p.grad().defined()) p.mutable_grad().zero_();
+  });
+  return chosen;
+}
+
 double Trainer::learning_rate(int step) const {
   const double t = static_cast<double>(step) / std::max(1, schedule_.steps);
   return schedule_.lr_min + 0.5 * (schedule_.lr_max - schedule_.lr_min) * (1.0 + std::cos(M_PI * t));
@@ -132,7 +171,7 @@ ValidationScore Trainer::validate(int step) {
   ValidationScore score;
   score.step = step;
   for (int frame : val_frames_) {
-    const Batch b = frame_batch(data_, frame, network_->spec().scale, channels_);
+    const Batch b = in_layout(frame_batch(data_, frame, network_->spec().scale, channels_), layout_);
     const auto out = forward(b, step);
     const auto image = out.image.clamp(0.0, 1.0);
     score.psnr += psnr(image, b.hr_color).item<double>();
@@ -168,6 +207,7 @@ void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const
   archive.write("spec", text_tensor(spec_to_yaml(network_->spec())));
   archive.write("outcome", text_tensor(to_json(outcome).dump()));
   archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
+  archive.write("layout", text_tensor(memory_layout_name(layout_)));
   write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
 }
 
@@ -220,6 +260,8 @@ bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, Trai
     outcome.best = score(j["best"]);
     outcome.last = score(j["last"]);
     for (const auto& s : j["history"]) outcome.history.push_back(score(s));
+    torch::Tensor layout;
+    if (archive.try_read("layout", layout)) layout_ = memory_layout_from_name(tensor_text(layout));
     archive.read("torch_rng", rng);
     at::Generator generator = at::detail::getDefaultCPUGenerator();  // a handle to the global generator
     generator.set_state(rng);
@@ -241,6 +283,8 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   optimizer_ = std::make_unique<torch::optim::Adam>(params, torch::optim::AdamOptions(schedule_.lr_max));
   TrainOutcome outcome;
   int step = 0;
+  NchwOnExit nchw_on_exit{*network_};
+  layout_ = MemoryLayout::Auto;
   if (checkpoint && resume && load_checkpoint(*checkpoint, step, outcome)) {
     outcome.resumed = true;
     spdlog::info("resuming from {} at step {}/{}", checkpoint->string(), step, schedule_.steps);
@@ -254,6 +298,10 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.channels = channels_;
   sampling.augment = schedule_.augment;
   PatchSampler sampler(data_, sampling);
+  // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).
+  if (layout_ == MemoryLayout::Auto) layout_ = choose_layout(sampler.build(step));
+  set_parameter_layout(*network_, layout_);
+  outcome.layout = memory_layout_name(layout_);
 
   network_->train();
   Progress progress("train", schedule_.steps, step);
@@ -266,7 +314,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
 
     // Batches are a function of the step, so a resumed run sees the same data.
-    const Batch batch = sampler.batch(step);
+    const Batch batch = in_layout(sampler.batch(step), layout_);
     const auto output = forward(batch, step);
     LossTerms terms = cgsr_loss(*network_, output, batch, loss_, shrink_);
     if (hooks_.extra_loss) terms.total = terms.total + hooks_.extra_loss(batch, output, step);

@@ -2,7 +2,9 @@
 // Training of a network on patches of a data set: Adam with cosine annealing, the CGSR loss,
 // gradient-norm clipping, a guard against non-finite steps, validation on full frames, best and
 // last weights, and checkpoints that resume the same schedule exactly (weights, optimizer state,
-// step, RNG state). Used by `cgsr train` and, through the search command, for search candidates.
+// step, RNG state, memory layout). Steps run in the memory layout measured fastest (or the one
+// the schedule names); a run is bit-reproducible within one layout, and the network is handed
+// back in NCHW. Used by `cgsr train` and, through the search command, for search candidates.
 
 #include <torch/optim/adam.h>
 
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "models/memory_layout.h"
 #include "models/model_file.h"
 #include "models/sr_network.h"
 #include "render_data/dataset.h"
@@ -34,6 +37,7 @@ struct TrainSchedule {
   int val_frames = 8;           // validation frames (spread over the split); 0 = all
   int checkpoint_every = 100;   // steps
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
+  std::string layout = "auto";  // activation memory layout: auto (measured) | nchw | nhwc
 };
 config::Schema<TrainSchedule> schedule_schema();
 
@@ -51,6 +55,7 @@ struct TrainOutcome {
   ValidationScore best, last;
   std::vector<ValidationScore> history;
   bool resumed = false;
+  std::string layout;  // the memory layout the steps ran in
 };
 nlohmann::ordered_json to_json(const TrainOutcome& outcome);
 
@@ -88,6 +93,8 @@ class Trainer {
 
  private:
   double learning_rate(int step) const;
+  // The schedule's layout; for auto, measured on a training step of `batch` (memory_layout.h).
+  MemoryLayout choose_layout(const Batch& batch);
   TrainOutput forward(const Batch& batch, int step);
   std::vector<torch::Tensor> tracked() const;  // the network's parameters, then the hooks' extras
   void save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome);
@@ -101,6 +108,7 @@ class Trainer {
   TrainHooks hooks_;
   std::vector<RenderChannel> channels_;
   std::vector<int> val_frames_;
+  MemoryLayout layout_ = MemoryLayout::Nchw;  // where run() keeps parameters and batches
   std::unique_ptr<torch::optim::Adam> optimizer_;
   std::vector<torch::Tensor> best_weights_, last_weights_;
 };

@@ -118,23 +118,19 @@ BenchTarget model_target(const BenchOptions& options) {
   const auto [w, h] = parse_size(options.input, "--input");
   ModelSource source = bench_source(options);
   SRNetwork net = source.network;
-  const MemoryLayout requested = memory_layout_from_name(options.layout);
-  const bool nhwc = requested == MemoryLayout::Nhwc ||
-                    (requested == MemoryLayout::Auto && prefers_channels_last(source.spec));
   const auto color = torch::rand({options.batch, 3, h, w});
   torch::Tensor info;
   if (net->has_rit()) {
     const int64_t f = net->rit()->info_factor();
     info = torch::rand({options.batch, static_cast<int64_t>(source.spec.rit.info_width()), h * f, w * f});
   }
+  const MemoryLayout layout = inference_layout(*net, color, info, memory_layout_from_name(options.layout));
   BenchTarget t;
   t.name = spec_summary(source.spec);
   t.runtime = "libtorch";
-  t.detail = std::string("layout ") + (nhwc ? "nhwc" : "nchw");
+  t.detail = std::string("layout ") + memory_layout_name(layout);
   t.macs = complexity(*net, w, h).macs * options.batch;
-  t.run = [net, color, info, nhwc]() mutable {
-    infer(*net, color, info, nhwc ? MemoryLayout::Nhwc : MemoryLayout::Nchw);
-  };
+  t.run = [net, color, info, layout]() mutable { infer(*net, color, info, layout); };
   return t;
 }
 

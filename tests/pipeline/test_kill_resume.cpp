@@ -6,7 +6,8 @@
 // without changing what it produces.
 //
 // Each test first runs the command uninterrupted (the reference), then kills a second run in a
-// new directory as soon as its first checkpoint exists, and resumes it. Runs use one thread, so a
+// new directory as soon as its first checkpoint exists, and resumes it. Runs use one thread and
+// name their memory layout (auto measures, and could choose differently in the two runs), so a
 // resumed run can be compared bit for bit with the reference.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
@@ -155,7 +156,8 @@ TEST(KillResume, TrainResumesFromItsCheckpointToTheUninterruptedResult) {
   const std::vector<std::string> train = {"train", "--data", data.string(), "--model", write_pan_spec(dir).string(),
                                           "--steps", "150", "--set", "schedule.batch_size=2", "--set",
                                           "schedule.patch_size=16", "--set", "schedule.validate_every=20", "--set",
-                                          "schedule.val_frames=1", "--set", "schedule.checkpoint_every=20"};
+                                          "schedule.val_frames=1", "--set", "schedule.checkpoint_every=20", "--set",
+                                          "schedule.layout=nhwc"};
   const auto reference = dir / "reference", out = dir / "run";
   auto r = run_cgsr_args(with_run_flags(train, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -198,8 +200,8 @@ TEST(KillResume, SearchResumedTwiceMakesTheUninterruptedPick) {
   min_candidates: 1
   tolerance_db: 0.5
 candidate:
-  schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
-final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5}
+  schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, layout: nhwc}
+final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5, layout: nhwc}
 )";
   const std::vector<std::string> search = {"search", "--config", config.string(), "--parent", parent.string(),
                                            "--data", data.string()};
@@ -272,7 +274,7 @@ TEST(KillResume, PruneResumesItsFineTuning) {
       "prune", "--config", std::string(CGSR_SOURCE_DIR) + "/configs/prune/quick.yaml", "--model", model.string(),
       "--data", data.string(), "--set", "warmup_steps=5", "--set", "finetune.schedule.steps=60", "--set",
       "finetune.schedule.checkpoint_every=5", "--set", "finetune.schedule.batch_size=2", "--set",
-      "finetune.schedule.patch_size=16", "--set", "eval.latency_runs=0"};
+      "finetune.schedule.patch_size=16", "--set", "finetune.schedule.layout=nhwc", "--set", "eval.latency_runs=0"};
   const auto reference = dir / "reference", out = dir / "run";
   auto r = run_cgsr_args(with_run_flags(prune, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
