@@ -1,6 +1,12 @@
 #include "core/metrics.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_reduce.h>
+
+#include <array>
 #include <cmath>
+#include <functional>
+#include <vector>
 
 #include "core/color.h"
 #include "core/error.h"
@@ -11,17 +17,20 @@ namespace {
 constexpr int kWindow = 11;
 constexpr double kSigma = 1.5;
 
-// Validates the pair and returns both as float64 NCHW after the Y conversion and border crop.
+// Validates the pair and returns both as contiguous NCHW, float64 inputs as they are and
+// everything else as float32, after the Y conversion and border crop. Finiteness is checked by
+// the loops that read them.
 std::pair<torch::Tensor, torch::Tensor> prepare(const torch::Tensor& output, const torch::Tensor& reference,
                                                 const QualityOptions& options, const char* metric) {
   if (!output.sizes().equals(reference.sizes()))
     throw Error(metric, "shapes differ: " + shape_string(output) + " vs " + shape_string(reference));
   if (output.dim() != 3 && output.dim() != 4)
     throw Error(metric, "expected CHW or NCHW, got shape " + shape_string(output));
-  require_finite(output, std::string(metric) + " input (output image)");
-  require_finite(reference, std::string(metric) + " input (reference image)");
-  auto a = (output.dim() == 3 ? output.unsqueeze(0) : output).to(torch::kFloat64);
-  auto b = (reference.dim() == 3 ? reference.unsqueeze(0) : reference).to(torch::kFloat64);
+  const auto type = output.scalar_type() == torch::kFloat64 && reference.scalar_type() == torch::kFloat64
+                        ? torch::kFloat64
+                        : torch::kFloat32;
+  auto a = (output.dim() == 3 ? output.unsqueeze(0) : output).to(type);
+  auto b = (reference.dim() == 3 ? reference.unsqueeze(0) : reference).to(type);
   if (options.y_channel) {
     a = rgb_to_y(a);
     b = rgb_to_y(b);
@@ -35,48 +44,121 @@ std::pair<torch::Tensor, torch::Tensor> prepare(const torch::Tensor& output, con
     a = a.slice(2, crop, a.size(2) - crop).slice(3, crop, a.size(3) - crop);
     b = b.slice(2, crop, b.size(2) - crop).slice(3, crop, b.size(3) - crop);
   }
-  return {a, b};
+  return {a.contiguous(), b.contiguous()};
 }
 
-// The normalized 1-D Gaussian; the 11x11 window is its outer product, applied as a row pass and
-// a column pass (22 instead of 121 multiply-adds per pixel: float64 convolutions are slow).
-torch::Tensor gaussian_1d() {
-  auto x = torch::arange(kWindow, torch::kFloat64) - (kWindow - 1) / 2.0;
-  auto g = torch::exp(-(x * x) / (2 * kSigma * kSigma));
-  return g / g.sum();
+[[noreturn]] void non_finite(const char* metric) {
+  throw Error(std::string(metric) + " input", "contains NaN or infinite values");
+}
+
+// The normalized 1-D Gaussian; the 11x11 window is its outer product, applied as a column pass
+// and a row pass (22 instead of 121 multiply-adds per pixel and statistic).
+std::array<double, kWindow> gaussian_1d() {
+  std::array<double, kWindow> g{};
+  double sum = 0;
+  for (int k = 0; k < kWindow; ++k) {
+    const double x = k - (kWindow - 1) / 2.0;
+    g[k] = std::exp(-(x * x) / (2 * kSigma * kSigma));
+    sum += g[k];
+  }
+  for (double& v : g) v /= sum;
+  return g;
+}
+
+// Mean SSIM of one plane over its valid region. Output rows are independent: each computes the
+// five Gaussian-weighted local statistics (means, second moments, cross moment) of its 11 input
+// rows in float64, first down the columns, then along the row. Returns NaN for non-finite input.
+template <class T>
+double plane_ssim(const T* a, const T* b, int64_t h, int64_t w) {
+  static const std::array<double, kWindow> g = gaussian_1d();
+  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+  const int64_t out_h = h - kWindow + 1, out_w = w - kWindow + 1;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, out_h), 0.0,
+      [&](const tbb::blocked_range<int64_t>& rows, double sum) {
+        std::vector<double> col(5 * static_cast<size_t>(w));
+        double *ma = col.data(), *mb = ma + w, *saa = mb + w, *sbb = saa + w, *sab = sbb + w;
+        for (int64_t y = rows.begin(); y < rows.end(); ++y) {
+          std::fill(col.begin(), col.end(), 0.0);
+          for (int k = 0; k < kWindow; ++k) {
+            const T* ra = a + (y + k) * w;
+            const T* rb = b + (y + k) * w;
+            const double gk = g[k];
+            for (int64_t x = 0; x < w; ++x) {
+              const double va = ra[x], vb = rb[x];
+              ma[x] += gk * va;
+              mb[x] += gk * vb;
+              saa[x] += gk * va * va;
+              sbb[x] += gk * vb * vb;
+              sab[x] += gk * va * vb;
+            }
+          }
+          for (int64_t x = 0; x < out_w; ++x) {
+            double mu_a = 0, mu_b = 0, e_aa = 0, e_bb = 0, e_ab = 0;
+            for (int k = 0; k < kWindow; ++k) {
+              mu_a += g[k] * ma[x + k];
+              mu_b += g[k] * mb[x + k];
+              e_aa += g[k] * saa[x + k];
+              e_bb += g[k] * sbb[x + k];
+              e_ab += g[k] * sab[x + k];
+            }
+            const double var_a = e_aa - mu_a * mu_a, var_b = e_bb - mu_b * mu_b, cov = e_ab - mu_a * mu_b;
+            sum += ((2 * mu_a * mu_b + c1) * (2 * cov + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
+          }
+        }
+        return sum;
+      },
+      std::plus<double>()) /
+         static_cast<double>(out_h * out_w);
+}
+
+template <class T>
+double sum_squared_error(const T* a, const T* b, int64_t count) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, count, 1 << 16), 0.0,
+      [&](const tbb::blocked_range<int64_t>& r, double sum) {
+        for (int64_t k = r.begin(); k < r.end(); ++k) {
+          const double d = static_cast<double>(a[k]) - static_cast<double>(b[k]);
+          sum += d * d;  // NaN or inf in either image makes d, and so the sum, non-finite
+        }
+        return sum;
+      },
+      std::plus<double>());
 }
 }  // namespace
 
 torch::Tensor psnr(const torch::Tensor& output, const torch::Tensor& reference, const QualityOptions& options) {
-  auto [a, b] = prepare(output, reference, options, "PSNR");
-  const auto mse = (a - b).pow(2).mean({1, 2, 3});
-  return -10.0 * torch::log10(mse);  // mse = 0 gives +inf
+  const auto [a, b] = prepare(output, reference, options, "PSNR");
+  const int64_t n = a.size(0), per_image = a.numel() / std::max<int64_t>(1, n);
+  auto out = torch::empty({n}, torch::kFloat64);
+  for (int64_t i = 0; i < n; ++i) {
+    const double sse = a.scalar_type() == torch::kFloat64
+                           ? sum_squared_error(a.data_ptr<double>() + i * per_image, b.data_ptr<double>() + i * per_image, per_image)
+                           : sum_squared_error(a.data_ptr<float>() + i * per_image, b.data_ptr<float>() + i * per_image, per_image);
+    if (!std::isfinite(sse)) non_finite("PSNR");
+    out[i] = -10.0 * std::log10(sse / static_cast<double>(per_image));  // mse = 0 gives +inf
+  }
+  return out;
 }
 
 torch::Tensor ssim(const torch::Tensor& output, const torch::Tensor& reference, const QualityOptions& options) {
-  auto [a, b] = prepare(output, reference, options, "SSIM");
-  if (a.size(2) < kWindow || a.size(3) < kWindow)
-    throw Error("SSIM", "needs images of at least 11x11 pixels (after cropping), got " + std::to_string(a.size(3)) +
-                            "x" + std::to_string(a.size(2)));
-  const int64_t c = a.size(1);
-  // The five local statistics (means, second moments, cross moment) of every channel in one
-  // grouped, separable Gaussian filter over the valid region.
-  const auto moments = torch::cat({a, b, a * a, b * b, a * b}, 1);
-  const int64_t groups = moments.size(1);
-  const auto g = gaussian_1d();
-  namespace F = torch::nn::functional;
-  const auto rows = F::conv2d(moments, g.view({1, 1, 1, kWindow}).expand({groups, 1, 1, kWindow}).contiguous(),
-                              F::Conv2dFuncOptions().groups(groups));
-  const auto local = F::conv2d(rows, g.view({1, 1, kWindow, 1}).expand({groups, 1, kWindow, 1}).contiguous(),
-                               F::Conv2dFuncOptions().groups(groups));
-  const auto stats = local.split(c, 1);
-  const auto &mu_a = stats[0], &mu_b = stats[1];
-  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
-  const auto var_a = stats[2] - mu_a * mu_a;
-  const auto var_b = stats[3] - mu_b * mu_b;
-  const auto cov = stats[4] - mu_a * mu_b;
-  const auto map = ((2 * mu_a * mu_b + c1) * (2 * cov + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
-  return map.mean({1, 2, 3});
+  const auto [a, b] = prepare(output, reference, options, "SSIM");
+  const int64_t n = a.size(0), c = a.size(1), h = a.size(2), w = a.size(3);
+  if (h < kWindow || w < kWindow)
+    throw Error("SSIM", "needs images of at least 11x11 pixels (after cropping), got " + std::to_string(w) + "x" +
+                            std::to_string(h));
+  auto out = torch::empty({n}, torch::kFloat64);
+  for (int64_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (int64_t ch = 0; ch < c; ++ch) {
+      const int64_t offset = (i * c + ch) * h * w;
+      sum += a.scalar_type() == torch::kFloat64 ? plane_ssim(a.data_ptr<double>() + offset, b.data_ptr<double>() + offset, h, w)
+                                                : plane_ssim(a.data_ptr<float>() + offset, b.data_ptr<float>() + offset, h, w);
+    }
+    if (!std::isfinite(sum)) non_finite("SSIM");
+    out[i] = sum / static_cast<double>(c);
+  }
+  return out;
 }
 
 void put_psnr(nlohmann::ordered_json& j, const std::string& key, double value) {

@@ -3,7 +3,8 @@
 //   PSNR: 10 log10(1 / MSE) on RGB (or BT.601 Y with y_channel); +inf for identical images.
 //   SSIM: Wang et al. 2004 with an 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03, L = 1,
 //         over the valid region (no padding), averaged over channels.
-// Both compute in float64 and return one value per image. Non-finite input is an error.
+// Both accumulate in float64 (parallel over rows) and return one value per image. Non-finite
+// input is an error.
 
 #include <torch/types.h>
 
