@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "core/error.h"
@@ -14,10 +15,17 @@
 
 namespace cgsr {
 
+namespace {
+std::optional<std::pair<int, int>> parse_frame_range(const std::string& text);
+}  // namespace
+
 config::Schema<EvalOptions> eval_schema_fields() {
   config::Schema<EvalOptions> s;
   s.field("split", &EvalOptions::split, "data set split").one_of({"train", "val", "test", "all"});
   s.field("max_frames", &EvalOptions::max_frames, "frames to evaluate (0 = the whole split)").at_least(0);
+  s.field("frames", &EvalOptions::frames, "frame index range A:B (A included, B not) within the split; empty = all")
+      .check([](const std::string& v) { return v.empty() || parse_frame_range(v).has_value(); },
+             "must be A:B with whole numbers 0 <= A < B");
   s.field("crop_border", &EvalOptions::crop_border, "HR pixels ignored at each border").range(0, 64);
   s.field("y_channel", &EvalOptions::y_channel, "PSNR/SSIM on BT.601 luma instead of RGB");
   s.field("temporal", &EvalOptions::temporal, "warping error between consecutive outputs");
@@ -27,8 +35,33 @@ config::Schema<EvalOptions> eval_schema_fields() {
 }
 
 namespace {
-std::vector<int> pick_frames(const Dataset& data, const EvalOptions& options) {
+std::optional<std::pair<int, int>> parse_frame_range(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  try {
+    size_t used_a = 0, used_b = 0;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    const int first = std::stoi(a, &used_a), end = std::stoi(b, &used_b);
+    if (used_a != a.size() || used_b != b.size() || first < 0 || end <= first) return std::nullopt;
+    return std::pair{first, end};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+}  // namespace
+
+std::vector<int> evaluation_frames(const Dataset& data, const EvalOptions& options) {
   std::vector<int> frames = data.frames(split_from_name(options.split));
+  if (!options.frames.empty()) {
+    const auto range = parse_frame_range(options.frames);
+    if (!range) throw Error("eval.frames", "'" + options.frames + "' is not a range A:B with 0 <= A < B");
+    std::vector<int> inside;
+    for (int f : frames)
+      if (f >= range->first && f < range->second) inside.push_back(f);
+    if (inside.empty())
+      throw Error(data.info().root.string(), "split '" + options.split + "' has no frame in " + options.frames);
+    frames = inside;
+  }
   if (frames.empty()) throw Error(data.info().root.string(), "split '" + options.split + "' has no frames");
   if (options.max_frames > 0 && static_cast<size_t>(options.max_frames) < frames.size()) {
     std::vector<int> picked;
@@ -38,6 +71,7 @@ std::vector<int> pick_frames(const Dataset& data, const EvalOptions& options) {
   return frames;
 }
 
+namespace {
 std::vector<RenderChannel> with_motion(std::vector<RenderChannel> channels) {
   if (std::find(channels.begin(), channels.end(), RenderChannel::Motion) == channels.end())
     channels.push_back(RenderChannel::Motion);
@@ -83,7 +117,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   quality.y_channel = options.y_channel;
   if (!options.save_frames.empty()) std::filesystem::create_directories(options.save_frames);
 
-  const auto frames = pick_frames(data, options);
+  const auto frames = evaluation_frames(data, options);
   Progress progress("eval " + result.name, static_cast<int64_t>(frames.size()));
   double psnr_sum = 0, ssim_sum = 0;
   int psnr_count = 0;
@@ -93,6 +127,11 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
       upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels));
     return upscaler.upscale(b);
   };
+  // The last evaluated frame and its output: consecutive frames (a range) reuse it as the
+  // previous output of the temporal error instead of upscaling that frame again.
+  int last_frame = -1;
+  Batch last_batch;
+  torch::Tensor last_sr;
   for (int frame : frames) {
     const Batch b = frame_batch(data, frame, result.scale, channels);
     const auto sr = upscale_frame(b, frame).clamp(0.0, 1.0);
@@ -112,8 +151,9 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
     }
     ssim_sum += score.ssim;
     if (temporal && frame > 0) {
-      const Batch prev = frame_batch(data, frame - 1, result.scale, channels);
-      const auto prev_sr = upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
+      const bool consecutive = last_frame == frame - 1;
+      const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels);
+      const auto prev_sr = consecutive ? last_sr : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
       const auto motion = hr_motion(b);
       score.temporal_error = warping_error(sr, prev_sr, motion);
       score.temporal_error_reference = warping_error(b.hr_color, prev.hr_color, motion);
@@ -124,6 +164,9 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
       write_image(std::filesystem::path(options.save_frames) / (result.name + "_" + name), sr[0]);
     }
     result.frames.push_back(score);
+    last_frame = frame;
+    last_batch = b;
+    last_sr = sr;
     progress.advance();
   }
   progress.finish();
@@ -131,13 +174,24 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   result.ssim = ssim_sum / static_cast<double>(frames.size());
   result.temporal_error = mean_of(result.frames, &FrameScore::temporal_error);
   result.temporal_error_reference = mean_of(result.frames, &FrameScore::temporal_error_reference);
+  // Quality is known before latency, which can take minutes at large sizes.
+  spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f} on {} frame(s)", result.name, result.psnr, result.ssim, frames.size());
 
   const Batch first = frame_batch(data, frames.front(), result.scale, upscaler.channels());
   result.lr_width = first.lr_color.size(3);
   result.lr_height = first.lr_color.size(2);
   result.cost = upscaler.cost(result.lr_width, result.lr_height);
-  if (options.latency_runs > 0)
-    result.latency = measure_latency([&] { upscaler.upscale(first); }, /*warmup=*/2, options.latency_runs);
+  if (options.latency_runs > 0) {
+    constexpr int kWarmup = 2;
+    Progress timing("latency " + result.name, kWarmup + options.latency_runs);
+    result.latency = measure_latency(
+        [&] {
+          upscaler.upscale(first);
+          timing.advance();
+        },
+        kWarmup, options.latency_runs);
+    timing.finish();
+  }
   return result;
 }
 

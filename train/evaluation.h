@@ -20,6 +20,7 @@ namespace cgsr {
 struct EvalOptions {
   std::string split = "test";
   int max_frames = 0;          // 0 = every frame of the split
+  std::string frames;          // "A:B": only frame indices A <= i < B of the split ("" = all)
   int crop_border = 0;         // pixels (HR) ignored at each side
   bool y_channel = false;      // PSNR/SSIM on BT.601 luma instead of RGB
   bool temporal = true;        // needs motion vectors and the previous frame
@@ -27,6 +28,10 @@ struct EvalOptions {
   std::string save_frames;     // directory for SR frames as PNG; "" = do not save
 };
 config::Schema<EvalOptions> eval_schema_fields();
+
+// The frame indices `options` selects from `data` (split, frames range, max_frames); throws
+// naming the range when it selects nothing.
+std::vector<int> evaluation_frames(const Dataset& data, const EvalOptions& options);
 
 struct FrameScore {
   int frame = 0;

@@ -57,13 +57,37 @@ void setup_eval(CLI::App& app) {
         flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");
         flag_to_key(sub, flags, "--crop-border", "eval.crop_border", "HR pixels ignored at each border");
         flag_to_key(sub, flags, "--save-frames", "eval.save_frames", "directory for upscaled frames");
+        flag_to_key(sub, flags, "--frames", "eval.frames", "frame index range A:B within the split");
+        flag_to_key(sub, flags, "--latency-runs", "eval.latency_runs", "timed runs for latency (0 = skip)");
       },
       [](const EvalCommandOptions& options, const YAML::Node&, RunDir* run_dir) { return run_eval(options, run_dir); },
       /*always_run_dir=*/true);
 }
 
+namespace {
+// The data set loading only the channels the upscalers read, plus motion vectors for the
+// temporal error: decoding a 1080p frame's other G-buffers would cost more than the metrics.
+Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upscaler>>& upscalers, bool temporal) {
+  const Dataset all = Dataset::open(path);
+  const auto& available = all.info().channels;
+  std::vector<RenderChannel> needed;
+  const auto need = [&](RenderChannel c) {
+    if (std::find(needed.begin(), needed.end(), c) == needed.end() &&
+        std::find(available.begin(), available.end(), c) != available.end())
+      needed.push_back(c);
+  };
+  for (const auto& u : upscalers)
+    for (auto c : u->channels()) need(c);
+  if (temporal) need(RenderChannel::Motion);
+  std::sort(needed.begin(), needed.end());
+  DatasetOpenOptions open;
+  open.channels = channel_names(needed);
+  if (open.channels.empty()) return all;  // an empty list means "all channels"
+  return Dataset::open(path, open);
+}
+}  // namespace
+
 nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir) {
-  const Dataset data = Dataset::open(options.data);
   std::vector<std::pair<std::string, std::string>> entries;  // (model entry, display name)
   for (size_t i = 0; i < options.models.size(); ++i) {
     const std::string name = options.names.empty() ? "" : options.names[i];
@@ -73,15 +97,16 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
       entries.emplace_back(options.models[i], name);
     }
   }
+  std::vector<std::unique_ptr<Upscaler>> upscalers;
+  for (const auto& [entry, name] : entries) upscalers.push_back(make_upscaler(entry, name, options.scale));
+  const Dataset data = open_for(options.data, upscalers, options.eval.temporal);
   std::vector<EvalResult> results;
   nlohmann::ordered_json json;
   json["data"] = data.info().root.string();
   json["evaluations"] = nlohmann::ordered_json::array();
-  for (const auto& [entry, name] : entries) {
-    auto upscaler = make_upscaler(entry, name, options.scale);
+  for (auto& upscaler : upscalers) {
     EvalResult r = evaluate(*upscaler, data, options.eval);
-    spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f}{}", r.name, r.psnr, r.ssim,
-                 r.latency ? ", " + std::to_string(r.latency->median_ms) + " ms" : "");
+    if (r.latency) spdlog::info("{}: latency {:.2f} ms (median of {})", r.name, r.latency->median_ms, r.latency->runs);
     if (run_dir) write_file_atomic(run_dir->file("frames_" + r.name + ".csv"), frames_csv(r));
     json["evaluations"].push_back(to_json(r));
     results.push_back(std::move(r));

@@ -5,24 +5,13 @@
 
 #include "core/runtime.h"
 #include "models/arch_spec.h"
-#include "tests/support/cli_runner.h"
+#include "tests/support/tiny_data.h"
 #include "train/trainer.h"
 
 using namespace cgsr;
 using namespace cgsr::test;
 
 namespace {
-
-const std::filesystem::path& tiny_data() {
-  static const std::filesystem::path dir = [] {
-    const auto d = scratch_dir("trainer") / "data";
-    const auto r = run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --out " +
-                            d.string() + " --threads 1");
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return d;
-  }();
-  return dir;
-}
 
 ArchSpec small_pan() { return spec_from_yaml("backbone: pan\nscale: 2\nblocks: 2\n", "test"); }
 
