@@ -215,6 +215,11 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
   } else {
     j["latency_ms"] = nullptr;
   }
+  if (r.onnxruntime_latency)
+    j["onnxruntime_latency_ms"] = {{"median", r.onnxruntime_latency->median_ms},
+                                   {"min", r.onnxruntime_latency->min_ms},
+                                   {"max", r.onnxruntime_latency->max_ms},
+                                   {"runs", r.onnxruntime_latency->runs}};
   if (r.cost) {
     j["params"] = r.cost->params;
     j["macs"] = r.cost->macs;
@@ -252,14 +257,16 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
     if (!j.at("temporal_error").is_null()) r.temporal_error = j.at("temporal_error").get<double>();
     if (!j.at("temporal_error_reference").is_null())
       r.temporal_error_reference = j.at("temporal_error_reference").get<double>();
-    if (!j.at("latency_ms").is_null()) {
-      LatencyStats l;
-      l.median_ms = j["latency_ms"].at("median");
-      l.min_ms = j["latency_ms"].at("min");
-      l.max_ms = j["latency_ms"].at("max");
-      l.runs = j["latency_ms"].at("runs");
-      r.latency = l;
-    }
+    const auto latency = [](const nlohmann::ordered_json& l) {
+      LatencyStats stats;
+      stats.median_ms = l.at("median");
+      stats.min_ms = l.at("min");
+      stats.max_ms = l.at("max");
+      stats.runs = l.at("runs");
+      return stats;
+    };
+    if (!j.at("latency_ms").is_null()) r.latency = latency(j["latency_ms"]);
+    if (j.contains("onnxruntime_latency_ms")) r.onnxruntime_latency = latency(j["onnxruntime_latency_ms"]);
     if (!j.at("params").is_null()) {
       Complexity c;
       c.params = j.at("params");

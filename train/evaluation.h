@@ -51,6 +51,9 @@ struct EvalResult {
   int identical_frames = 0;
   std::optional<double> temporal_error, temporal_error_reference;
   std::optional<LatencyStats> latency;
+  // The exported ONNX file of the network in ONNX Runtime on the same input (what a game would
+  // ship); set by the report stage of `cgsr run`.
+  std::optional<LatencyStats> onnxruntime_latency;
   std::optional<Complexity> cost;
 };
 

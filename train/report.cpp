@@ -20,7 +20,7 @@ std::string fixed(double v, int digits) {
 }
 
 struct Cells {
-  std::string params, macs, latency, psnr, ssim, temporal;
+  std::string params, macs, latency, ort_latency, psnr, ssim, temporal;
 };
 
 Cells cells(const EvalResult& r) {
@@ -28,6 +28,7 @@ Cells cells(const EvalResult& r) {
   c.params = r.cost ? fixed(r.cost->params / 1000.0, 1) : "NA";
   c.macs = r.cost ? fixed(r.cost->macs / 1e9, 2) : "NA";
   c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
+  c.ort_latency = r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 2) : "-";
   c.psnr = fixed(r.psnr, 2);
   c.ssim = fixed(r.ssim, 4);
   c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
@@ -72,35 +73,40 @@ std::string report_markdown(const ReportTable& table) {
   const auto& first = table.rows.front();
   md << "### " << table.dataset << " x" << table.scale << " (" << first.split << " split, " << first.frames.size()
      << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
-  md << "| Model | Params (k) | MACs (G) | Latency (ms) | PSNR (dB) | SSIM | Temporal error (x1e-3) |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|\n";
+  const bool ort = std::any_of(table.rows.begin(), table.rows.end(),
+                               [](const EvalResult& r) { return r.onnxruntime_latency.has_value(); });
+  md << "| Model | Params (k) | MACs (G) | Latency (ms) |" << (ort ? " ONNX Runtime (ms) |" : "")
+     << " PSNR (dB) | SSIM | Temporal error (x1e-3) |\n";
+  md << "|---|---:|---:|---:|" << (ort ? "---:|" : "") << "---:|---:|---:|\n";
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
     const auto c = cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | " << c.latency
-       << " | " << c.psnr << " | " << c.ssim << " | " << c.temporal << " |\n";
+       << " | " << (ort ? c.ort_latency + " | " : "") << c.psnr << " | " << c.ssim << " | " << c.temporal << " |\n";
   }
   if (first.temporal_error_reference)
     md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
        << "e-3. ";
   md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
-        "of repeated runs on this machine.\n";
+        "of repeated runs on this machine"
+     << (ort ? " (cgsr's own inference; ONNX Runtime: the exported file on the same input)" : "") << ".\n";
   return md.str();
 }
 
 std::string report_csv(const std::vector<ReportTable>& tables) {
   std::ostringstream csv;
-  csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames\n";
+  csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames,"
+         "onnxruntime_latency_ms\n";
   for (const auto& t : tables)
     for (const auto& r : t.rows) {
       csv << t.dataset << "," << t.scale << "," << r.name << "," << (r.cost ? std::to_string(r.cost->params) : "")
           << "," << (r.cost ? std::to_string(r.cost->macs) : "") << ","
           << (r.latency ? fixed(r.latency->median_ms, 4) : "") << "," << fixed(r.psnr, 4) << "," << fixed(r.ssim, 6)
           << "," << (r.temporal_error ? fixed(*r.temporal_error, 6) : "") << ","
-          << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size()
-          << "\n";
+          << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size() << ","
+          << (r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 4) : "") << "\n";
     }
   return csv.str();
 }

@@ -2,9 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <map>
 
 #include "cli/commands/eval.h"
 #include "cli/commands/export.h"
@@ -19,6 +21,8 @@
 #include "core/timing.h"
 #include "core/yaml_json.h"
 #include "export/exporter.h"
+#include "export/onnx_writer.h"
+#include "export/onnxruntime_runner.h"
 #include "models/model_file.h"
 #include "render_data/dataset.h"
 #include "render_data/patch_sampler.h"
@@ -182,6 +186,42 @@ const EvalResult* find_result(const std::vector<EvalResult>& results, const std:
 
 }  // namespace
 
+namespace {
+// ONNX Runtime's latency for every row with an exported file, on the frame the side-by-side
+// timing used (the exported file takes the same inputs: lr_color, lr_render_info).
+void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<std::string, fs::path>& onnx_files,
+                         const std::vector<Batch>& frames, int runs) {
+  if (const std::string why = OnnxRuntimeRunner::unavailable_reason(); !why.empty()) {
+    spdlog::warn("report: no ONNX Runtime latency column ({})", why);
+    return;
+  }
+  std::vector<OrtModelJob> jobs;
+  std::vector<size_t> rows;
+  for (size_t i = 0; i < evaluations.size(); ++i) {
+    const auto file = onnx_files.find(evaluations[i].name);
+    if (file == onnx_files.end() || !fs::exists(file->second)) continue;
+    // The file records its spec; a network of that spec picks its rendering channels from the batch.
+    const SRNetwork net(spec_from_yaml(inspect_onnx_file(file->second).metadata_value("cgsr.spec"), file->second.string()));
+    NamedTensors inputs = {{kExportColorInput, frames[i].lr_color}};
+    if (net->has_rit()) inputs.emplace_back(kExportInfoInput, net->info_input(frames[i]));
+    jobs.push_back({file->second, {{inputs, /*warmup=*/2, runs}}});
+    rows.push_back(i);
+  }
+  if (jobs.empty()) return;
+  spdlog::info("timing {} exported models in ONNX Runtime ({} runs each)", jobs.size(), runs);
+  const auto results = OnnxRuntimeRunner().run_checked(jobs);
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const auto& ms = results[k].runs.at(0).times_ms;
+    LatencyStats stats;
+    stats.median_ms = median(ms);
+    stats.min_ms = *std::min_element(ms.begin(), ms.end());
+    stats.max_ms = *std::max_element(ms.begin(), ms.end());
+    stats.runs = static_cast<int>(ms.size());
+    evaluations[rows[k]].onnxruntime_latency = stats;
+  }
+}
+}  // namespace
+
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
   const auto t0 = std::chrono::steady_clock::now();
   StageRunner stages(root, options.from, static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1));
@@ -275,9 +315,17 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   const Resolution lr = data.info().resolutions.front();
   std::vector<ExportCommandOptions> exports;
   YAML::Node export_config(YAML::NodeType::Sequence);
-  for (const auto& [model, stem] : {std::pair{searched_file, std::string("cg_optimized")},
+  // The CG-optimized and pruned networks go out in every format; the others as ONNX only, for
+  // the report's ONNX Runtime latency column.
+  const fs::path mmp_file = stages.dir("prune") / "mmp.cgsr";
+  for (const auto& [model, stem] : {std::pair{backbone_file, std::string("backbone")},
+                                    std::pair{enhanced_file, std::string("cg_enhanced")},
+                                    std::pair{searched_file, std::string("cg_optimized")},
+                                    std::pair{mmp_file, std::string("mmp")},
                                     std::pair{pruned_file, std::string("pruned")}}) {
+    const bool deployed = stem == "cg_optimized" || stem == "pruned";
     for (const auto& format : options.export_formats) {
+      if (!deployed && format != "onnx") continue;
       ExportCommandOptions e;
       e.seed = options.seed;
       e.threads = options.threads;
@@ -290,7 +338,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
       export_config.push_back(export_schema().emit(e));
     }
   }
-  const auto exported = stages.run("export", export_config, {searched.hash, pruned.hash}, [&](RunDir&, bool) {
+  const auto exported = stages.run("export", export_config, {trained.hash, enhance.hash, searched.hash, pruned.hash},
+                                   [&](RunDir&, bool) {
     nlohmann::ordered_json j = nlohmann::ordered_json::array();
     for (const auto& e : exports) j.push_back(run_export(e));
     return nlohmann::ordered_json{{"exports", j}};
@@ -323,10 +372,17 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
       {searched_name, searched_file},
       {searched_name + " MMP", stages.dir("prune") / "mmp.cgsr"},
       {searched_name + " hybrid", pruned_file}};
+  // Each row's exported ONNX file (the static network for the hybrid model's static row).
+  const std::map<std::string, fs::path> onnx_files = {
+      {trained.summary.at("name").get<std::string>(), stages.dir("export") / "backbone.onnx"},
+      {enhance.summary.at("name").get<std::string>(), stages.dir("export") / "cg_enhanced.onnx"},
+      {searched_name, stages.dir("export") / "cg_optimized.onnx"},
+      {searched_name + " MMP", stages.dir("export") / "mmp.onnx"},
+      {searched_name + " static", stages.dir("export") / "pruned.onnx"}};
   const std::vector<std::string> runs = {(stages.dir("eval") / "results.json").string(),
                                          (stages.dir("prune") / "results.json").string()};
   const auto reported = stages.run(
-      "report", YAML::Node(runs), {evaluated.hash, pruned.hash}, [&](RunDir& dir, bool) {
+      "report", YAML::Node(runs), {evaluated.hash, pruned.hash, exported.hash}, [&](RunDir& dir, bool) {
         std::vector<EvalResult> evaluations = collect_evaluations(runs);
         if (eval.latency_runs > 0) {
           std::vector<std::unique_ptr<Upscaler>> upscalers;
@@ -347,6 +403,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
           spdlog::info("timing {} models side by side ({} interleaved rounds)", timed.size(), eval.latency_runs);
           const auto latency = measure_latency_interleaved(timed, /*warmup=*/2, eval.latency_runs);
           for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
+          time_in_onnxruntime(evaluations, onnx_files, frames, eval.latency_runs);
         }
         return write_report(evaluations, dir);
       });
