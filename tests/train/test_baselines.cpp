@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 #include "train/baselines/fsr1.h"
 #include "train/baselines/interpolation.h"
 
@@ -106,4 +110,89 @@ TEST(Fsr1, ClampsSaturatedAndRejectsNonFiniteInput) {
   auto nan = torch::rand({1, 3, 4, 4});
   nan[0][1][2][2] = std::nanf("");
   EXPECT_ANY_THROW(upscale_fsr1(nan, 2));
+}
+
+// The tests below pin the banded Lanczos to its dense matrix form and to its behaviour on
+// extreme input, and check properties every upscaler must have.
+namespace {
+// Output j of an upscale by `scale` samples the input at this coordinate (DESIGN.md convention).
+double sample_coordinate(int64_t j, int scale) { return (j + 0.5) / scale - 0.5; }
+
+double lanczos3(double x) {
+  auto sinc = [](double v) { return v == 0 ? 1.0 : std::sin(M_PI * v) / (M_PI * v); };
+  return std::abs(x) < 3 ? sinc(x) * sinc(x / 3) : 0.0;
+}
+
+double max_abs_diff(const torch::Tensor& a, const torch::Tensor& b) {
+  return (a.to(torch::kFloat64) - b.to(torch::kFloat64)).abs().max().item<double>();
+}
+}  // namespace
+
+TEST(Baselines, LanczosEqualsTheDenseMatrixProduct) {
+  torch::manual_seed(2);
+  for (auto [h, w] : std::vector<std::pair<int64_t, int64_t>>{{1, 1}, {2, 2}, {1, 4}, {3, 5}, {17, 13}})
+    for (int scale : {2, 3, 4}) {
+      const auto lr = torch::rand({2, 3, h, w}, torch::kFloat64);
+      const auto rows = resampling_matrix(h, h * scale, 3.0, lanczos3);
+      const auto cols = resampling_matrix(w, w * scale, 3.0, lanczos3);
+      const auto dense = torch::matmul(torch::matmul(rows, lr), cols.t());
+      const std::string where = std::to_string(h) + "x" + std::to_string(w) + " x" + std::to_string(scale);
+      EXPECT_LT(max_abs_diff(upscale_lanczos(lr, scale), dense), 1e-12) << where;  // double in, double out
+      const auto single = upscale_lanczos(lr.to(torch::kFloat32), scale);
+      ASSERT_EQ(single.scalar_type(), torch::kFloat32);
+      EXPECT_LT(max_abs_diff(single, dense), 1e-5) << where;
+    }
+}
+
+TEST(Baselines, LanczosIsLinearAndDoesNotClamp) {
+  torch::manual_seed(3);
+  const auto lr = torch::rand({1, 3, 9, 11});
+  EXPECT_EQ(upscale_lanczos(torch::zeros({1, 3, 4, 4}), 3).abs().max().item<float>(), 0.0f);
+  EXPECT_LT(max_abs_diff(upscale_lanczos(torch::ones({1, 3, 4, 4}), 3), torch::ones({1, 3, 12, 12})), 1e-6);
+  // Values outside [0,1] are not clamped: Lanczos is linear.
+  const auto wide = lr * 4 - 1.5;
+  EXPECT_LT(max_abs_diff(upscale_lanczos(wide, 2), upscale_lanczos(lr, 2) * 4 - 1.5), 1e-5);
+  for (float v : {-0.5f, 2.0f})
+    EXPECT_LT(max_abs_diff(upscale_lanczos(torch::full({1, 3, 5, 3}, v), 2), torch::full({1, 3, 10, 6}, v)), 1e-6);
+}
+
+TEST(Baselines, LanczosNanReachesOnlyTheOutputsWhoseTapsCoverIt) {
+  auto lr = torch::rand({1, 3, 16, 16});
+  lr[0][1][8][5] = std::nanf("");
+  const auto sr = upscale_lanczos(lr, 2);
+  const auto nan = torch::isnan(sr);
+  EXPECT_FALSE(nan[0][0].any().item<bool>());
+  EXPECT_FALSE(nan[0][2].any().item<bool>());
+  EXPECT_TRUE(nan[0][1][16][10].item<bool>());
+  const auto mask = nan[0][1];
+  for (int64_t y = 0; y < 32; ++y)
+    for (int64_t x = 0; x < 32; ++x) {
+      const bool covered = std::abs(sample_coordinate(y, 2) - 8) <= 3 && std::abs(sample_coordinate(x, 2) - 5) <= 3;
+      if (!covered) {
+        ASSERT_FALSE(mask[y][x].item<bool>()) << y << "," << x;
+      }
+    }
+}
+
+TEST(Baselines, TinyInputsGiveTheTexelEverywhere) {
+  // A 1x1 image has one texel: every upscaler must spread it unchanged (FSR clamps to [0,1]).
+  torch::manual_seed(4);
+  const auto lr = torch::rand({2, 3, 1, 1});
+  for (const auto& [name, upscale] : all_upscalers())
+    for (int scale : {2, 3, 4}) {
+      const auto sr = upscale(lr, scale);
+      ASSERT_EQ(sr.sizes(), (std::vector<int64_t>{2, 3, scale, scale})) << name;
+      EXPECT_LT(max_abs_diff(sr, lr.expand_as(sr)), 1e-6) << name << " x" << scale;
+    }
+}
+
+TEST(Baselines, BatchItemsAreIndependent) {
+  torch::manual_seed(5);
+  const auto lr = torch::rand({3, 3, 7, 10});
+  for (const auto& [name, upscale] : all_upscalers())
+    for (int scale : {2, 3}) {
+      const auto batch = upscale(lr, scale);
+      for (int64_t i = 0; i < 3; ++i)
+        EXPECT_TRUE(torch::equal(batch[i], upscale(lr.slice(0, i, i + 1), scale)[0])) << name << " item " << i;
+    }
 }
