@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libtorch-dev          # LibTorch 1.13 (CPU)
+  libdnnl-dev           # oneDNN headers and CMake package (the fused inference path)
   libopencv-dev         # image I/O, OpenCV DNN for export verification
   libyaml-cpp-dev libtbb-dev libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
