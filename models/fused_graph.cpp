@@ -107,6 +107,7 @@ struct PlannedStep {
   int position = 0;        // index of the last graph op it computes: steps run in this order
   std::vector<int> reads;  // values
   int writes = -1;
+  int overwrites = -1;     // a value whose buffer it writes in place (the residual of a sum post-op)
   std::vector<Call> calls;
   std::unique_ptr<TorchCall> torch_call;
 };
@@ -151,6 +152,7 @@ class Compiler {
     for (size_t v = 0; v < g_.values.size(); ++v)
       if (!virtual_[v]) p_.mds[v] = memory::desc(p_.dims[v], kF32, tag_);
     done_.assign(g_.ops.size(), false);
+    position_of_.assign(g_.ops.size(), -1);
     for (int i = 0; i < static_cast<int>(g_.ops.size()); ++i)
       if (!done_[i] && !(g_.ops[i].kind == OpKind::Concat && virtual_[g_.ops[i].output])) plan_op(i);
     std::stable_sort(p_.steps.begin(), p_.steps.end(),
@@ -266,12 +268,18 @@ class Compiler {
     return binary.inputs[0] == operand ? binary.inputs[1] : binary.inputs[0];
   }
 
-  // Appends the chain as post-ops (numbered from `index`), with the operands it reads.
+  // Appends the chain as post-ops (numbered from `index`), with the operands it reads. The op
+  // `summed` (an Add whose other operand already is in the destination) becomes a sum post-op.
   void append_chain(const std::vector<int>& chain, int value, dnnl::post_ops& post, int index, Call& call,
-                    PlannedStep& step) {
+                    PlannedStep& step, int summed = -1, bool summed_already = false) {
     for (int j : chain) {
       const Op& op = g_.ops[j];
-      if (is_activation(op.kind)) {
+      if (j == summed) {
+        if (!summed_already) {
+          post.append_sum(1.f);
+          ++index;
+        }
+      } else if (is_activation(op.kind)) {
         const auto [algorithm, alpha] = activation(op);
         post.append_eltwise(1.f, algorithm, alpha, 0.f);
         ++index;
@@ -308,11 +316,14 @@ class Compiler {
       const std::vector<int> full = fusable_chain(op.output);
       for (size_t n = full.size() + 1; n-- > 0;) {
         const std::vector<int> chain(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(n));
-        PlannedStep step;
-        const bool ok = op.kind == OpKind::Conv ? plan_conv(i, chain, step) : plan_binary(i, chain, step);
-        if (ok && (n == 0 || !is_reference(step.info.implementation))) {
-          finish(i, chain, std::move(step));
-          return;
+        for (bool in_place : {true, false}) {
+          PlannedStep step;
+          const bool ok =
+              op.kind == OpKind::Conv ? plan_conv(i, chain, step, in_place) : !in_place && plan_binary(i, chain, step);
+          if (ok && (n == 0 || !is_reference(step.info.implementation))) {
+            finish(i, chain, std::move(step));
+            return;
+          }
         }
       }
       CGSR_CHECK(false, "fused graph: no oneDNN kernel for " + op.name);
@@ -323,9 +334,13 @@ class Compiler {
   }
 
   void finish(int i, const std::vector<int>& chain, PlannedStep step) {
-    done_[i] = true;
-    for (int j : chain) done_[j] = true;
     step.position = chain.empty() ? i : chain.back();
+    done_[i] = true;
+    position_of_[i] = step.position;
+    for (int j : chain) {
+      done_[j] = true;
+      position_of_[j] = step.position;
+    }
     step.writes = chain_end(g_.ops[i].output, chain);
     p_.steps.push_back(std::move(step));
   }
@@ -348,8 +363,35 @@ class Compiler {
     if (is_reference(impl) && !is_reference(s)) s = impl + "+" + s;
   }
 
+  // Whether a step ending at `position` may overwrite `value` while `reader` adds it: every other
+  // op reading it belongs to an earlier step (ops not planned yet, the step's own convolution
+  // and chain included, do not qualify).
+  bool overwritable(int value, int reader, int position) const {
+    if (is_output_[value] || virtual_[value]) return false;
+    for (int u : uses_[value]) {
+      if (u == reader) continue;
+      if (!done_[u] || position_of_[u] < 0 || position_of_[u] >= position) return false;
+    }
+    return true;
+  }
+
+  // The residual add of a chain that can be a sum post-op into the residual's own buffer (no
+  // operand to stream in, and the brgemm kernels take sums but not binary post-ops): {add op,
+  // residual value}, or {-1, -1}. Split convolutions sum their parts into the destination, so
+  // there only a leading add can be the first thing in it.
+  std::pair<int, int> in_place_add(int i, const std::vector<int>& chain, bool split) const {
+    int value = g_.ops[i].output;
+    for (size_t k = 0; k < chain.size() && (!split || k == 0); ++k) {
+      const Op& op = g_.ops[chain[k]];
+      if (op.kind == OpKind::Add && overwritable(other(op, value), chain[k], chain.back()))
+        return {chain[k], other(op, value)};
+      value = op.output;
+    }
+    return {-1, -1};
+  }
+
   // A convolution, or one per part of a concatenation it reads (summed into the same output).
-  bool plan_conv(int i, const std::vector<int>& chain, PlannedStep& step) {
+  bool plan_conv(int i, const std::vector<int>& chain, PlannedStep& step, bool in_place) {
     const Op& op = g_.ops[i];
     struct Part {
       int value;
@@ -371,6 +413,12 @@ class Compiler {
       step.info.ops = {op.name};
     }
     const int out = chain_end(op.output, chain);
+    const auto [summed, residual] = in_place ? in_place_add(i, chain, parts.size() > 1) : std::pair{-1, -1};
+    if (in_place && summed < 0) return false;
+    if (summed >= 0) {
+      step.overwrites = residual;
+      step.reads.push_back(residual);
+    }
     const int64_t kh = op.weight.size(2), kw = op.weight.size(3), oc = op.weight.size(0), g = op.groups;
     for (size_t k = 0; k < parts.size(); ++k) {
       const int64_t ic = width(parts[k].value);
@@ -384,11 +432,12 @@ class Compiler {
       Call call;
       dnnl::post_ops post;
       int index = 0;
-      if (k > 0) {
+      const bool split = parts.size() > 1;
+      if (k > 0 || (split && summed >= 0)) {
         post.append_sum(1.f);
         ++index;
       }
-      if (k + 1 == parts.size()) append_chain(chain, op.output, post, index, call, step);
+      if (k + 1 == parts.size()) append_chain(chain, op.output, post, index, call, step, summed, split);
       const dnnl::convolution_forward::desc desc(
           dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, md(parts[k].value), weight_any,
           bias_md, md(out), {op.stride, op.stride}, {op.dilation - 1, op.dilation - 1}, {op.padding, op.padding},
@@ -569,6 +618,7 @@ class Compiler {
   void place_values() {
     const int steps = static_cast<int>(p_.steps.size());
     const size_t count = g_.values.size();
+    constexpr int kNever = -3;
     std::vector<int> last(count, -2);
     for (int s = 0; s < steps; ++s)
       for (int v : p_.steps[s].reads) last[v] = std::max(last[v], s);
@@ -595,7 +645,13 @@ class Compiler {
     for (const auto& [name, v] : g_.inputs) allocate(v);
     release(-2);  // inputs nothing reads
     for (int s = 0; s < steps; ++s) {
-      allocate(p_.steps[s].writes);
+      const PlannedStep& step = p_.steps[s];
+      if (step.overwrites >= 0) {  // the buffer passes to the result
+        buffer_of[step.writes] = buffer_of[step.overwrites];
+        last[step.overwrites] = kNever;
+      } else {
+        allocate(step.writes);
+      }
       release(s);
     }
     for (size_t b = 0; b < sizes.size(); ++b)
@@ -658,6 +714,7 @@ class Compiler {
   memory::format_tag tag_ = memory::format_tag::nhwc;
   std::vector<std::vector<int>> uses_;
   std::vector<bool> is_output_, virtual_, done_;
+  std::vector<int> position_of_;  // per op: position of the step computing it (once planned)
   std::vector<int> buffer_of_;
   std::vector<Call*> scratch_calls_;
 };

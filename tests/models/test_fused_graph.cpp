@@ -49,11 +49,12 @@ double max_abs_diff(const torch::Tensor& a, const torch::Tensor& b) {
   return (a - b).abs().max().item<double>();
 }
 
-// Largest difference seen by the comparisons below (printed by the last test).
-double largest_diff = 0;
+// Largest differences seen by the comparisons of the running test (printed at its end).
+double largest_relative = 0, largest_absolute = 0;
 
 // Runs the fused graph and the interpreter on the same inputs; the outputs agree to `tolerance`
-// relative to the output's magnitude (at least 1).
+// relative to the output's magnitude when it exceeds 1 (inputs of 1e3 give outputs near 1e3,
+// where float32 values are 6e-5 apart: no other summation order stays within 1e-4 of them).
 void expect_equal_outputs(FusedGraph& fused, const graph::Graph& g, const Inputs& in, double tolerance = 1e-4) {
   torch::NoGradGuard no_grad;
   const auto expected = graph::run(g, in);
@@ -66,12 +67,14 @@ void expect_equal_outputs(FusedGraph& fused, const graph::Graph& g, const Inputs
     EXPECT_EQ(got[i].second.scalar_type(), torch::kFloat);
     const double scale = std::max(1.0, expected[i].second.abs().max().item<double>());
     const double diff = max_abs_diff(got[i].second, expected[i].second);
-    largest_diff = std::max(largest_diff, diff / scale);
+    largest_relative = std::max(largest_relative, diff / scale);
+    largest_absolute = std::max(largest_absolute, diff);
     EXPECT_LE(diff, tolerance * scale) << "output " << got[i].first << " of magnitude " << scale;
   }
 }
 
-void expect_network_matches(const ArchSpec& spec, uint64_t seed, FusedGraph::Options options = {}) {
+// One image 12x17, then a batch of two (a second plan).
+void expect_network_matches(const ArchSpec& spec, uint64_t seed, FusedGraph::Options options = FusedGraph::Options()) {
   SRNetwork net = build(spec, seed);
   const graph::Graph g = net->describe();
   FusedGraph fused(g, options);
@@ -122,7 +125,16 @@ ArchSpec reduced_srcnn(int scale) {
 
 }  // namespace
 
-TEST(FusedGraph, EveryBackboneAtEveryScale) {
+class FusedGraphTest : public ::testing::Test {
+ protected:
+  void SetUp() override { largest_relative = largest_absolute = 0; }
+  void TearDown() override {
+    std::printf("largest difference to graph::run: %.3g (%.3g relative to the output's magnitude)\n",
+                largest_absolute, largest_relative);
+  }
+};
+
+TEST_F(FusedGraphTest, EveryBackboneAtEveryScale) {
   uint64_t seed = 10;
   for (const auto& name : backbone_registry().names())
     for (int scale : {2, 3, 4}) {
@@ -137,18 +149,18 @@ TEST(FusedGraph, EveryBackboneAtEveryScale) {
     }
 }
 
-TEST(FusedGraph, RitVariants) {
+TEST_F(FusedGraphTest, RitVariants) {
   uint64_t seed = 40;
   for (const char* b : {"pan", "edsr", "srcnn"})
     for (const char* source : {"lr", "hr_pooled"})
-      for (const char* fusion : {"concat", "add"})
-        for (int scale : {2, 4}) {
-          SCOPED_TRACE(std::string(b) + " x" + std::to_string(scale) + " " + source + " " + fusion);
-          expect_network_matches(with_rit(default_spec(b, scale), source, fusion), ++seed);
-        }
+      for (const char* fusion : {"concat", "add"}) {
+        const int scale = fusion[0] == 'c' ? 2 : 4;
+        SCOPED_TRACE(std::string(b) + " x" + std::to_string(scale) + " " + source + " " + fusion);
+        expect_network_matches(with_rit(default_spec(b, scale), source, fusion), ++seed);
+      }
 }
 
-TEST(FusedGraph, ReducedOddWidths) {
+TEST_F(FusedGraphTest, ReducedOddWidths) {
   uint64_t seed = 70;
   for (int scale : {2, 3, 4}) {
     SCOPED_TRACE("x" + std::to_string(scale));
@@ -161,10 +173,13 @@ TEST(FusedGraph, ReducedOddWidths) {
 
 // Every design the options select computes the same, including the blocked layout whose padded
 // channels (widths 13, 7) must never leak into results.
-TEST(FusedGraph, EveryOptionComputesTheSame) {
+TEST_F(FusedGraphTest, EveryOptionComputesTheSame) {
   uint64_t seed = 90;
-  for (const ArchSpec& spec : {with_rit(reduced_pan(2), "lr", "concat"), with_rit(default_spec("pan", 4), "lr", "add"),
-                               reduced_edsr(3), with_rit(reduced_srcnn(2), "hr_pooled", "concat")})
+  for (const ArchSpec& spec : {with_rit(reduced_pan(4), "lr", "concat"), reduced_edsr(3),
+                               with_rit(reduced_srcnn(2), "hr_pooled", "concat")}) {
+    SRNetwork net = build(spec, ++seed);
+    const graph::Graph g = net->describe();
+    const Inputs in = random_of(spec, 2, 7, 9);
     for (auto layout : {FusedGraph::Layout::ChannelsLast, FusedGraph::Layout::Blocked})
       for (bool fuse : {true, false})
         for (bool split : {true, false}) {
@@ -174,11 +189,13 @@ TEST(FusedGraph, EveryOptionComputesTheSame) {
           options.layout = layout;
           options.fuse = fuse;
           options.split_concat = split;
-          expect_network_matches(spec, ++seed, options);
+          FusedGraph fused(g, options);
+          expect_equal_outputs(fused, g, in);
         }
+  }
 }
 
-TEST(FusedGraph, ExtremeInputs) {
+TEST_F(FusedGraphTest, ExtremeInputs) {
   uint64_t seed = 120;
   for (const ArchSpec& spec : {with_rit(default_spec("pan", 2), "lr", "concat"), default_spec("edsr", 3),
                                default_spec("srcnn", 4), with_rit(reduced_pan(4), "hr_pooled", "add")}) {
@@ -198,7 +215,7 @@ TEST(FusedGraph, ExtremeInputs) {
   }
 }
 
-TEST(FusedGraph, TinyInputsAndRecompilingForNewSizes) {
+TEST_F(FusedGraphTest, TinyInputsAndRecompilingForNewSizes) {
   uint64_t seed = 140;
   for (const ArchSpec& spec : {with_rit(default_spec("pan", 3), "hr_pooled", "concat"), default_spec("edsr", 4),
                                default_spec("srcnn", 2)}) {
@@ -215,7 +232,7 @@ TEST(FusedGraph, TinyInputsAndRecompilingForNewSizes) {
   }
 }
 
-TEST(FusedGraph, SnapshotOfTheWeights) {
+TEST_F(FusedGraphTest, SnapshotOfTheWeights) {
   SRNetwork net = build(default_spec("pan", 2), 160);
   FusedGraph fused(net->describe());
   const auto color = torch::rand({1, 3, 6, 7});
@@ -230,7 +247,7 @@ TEST(FusedGraph, SnapshotOfTheWeights) {
 }
 
 // PAN's element-wise ops all end up inside convolutions, and no step needs a reference kernel.
-TEST(FusedGraph, PanPlanFusesAttentionAndResiduals) {
+TEST_F(FusedGraphTest, PanPlanFusesAttentionAndResiduals) {
   SRNetwork net = build(with_rit(default_spec("pan", 2), "lr", "concat"), 170);
   const graph::Graph g = net->describe();
   FusedGraph fused(g);
@@ -268,7 +285,7 @@ TEST(FusedGraph, PanPlanFusesAttentionAndResiduals) {
   EXPECT_FALSE(fused.plan_string().empty());
 }
 
-TEST(FusedGraph, WrongInputsAreErrors) {
+TEST_F(FusedGraphTest, WrongInputsAreErrors) {
   const ArchSpec spec = with_rit(default_spec("pan", 2), "hr_pooled", "concat");
   SRNetwork net = build(spec, 180);
   FusedGraph fused(net->describe());
@@ -289,10 +306,4 @@ TEST(FusedGraph, WrongInputsAreErrors) {
   // Non-contiguous inputs are fine.
   const auto wide = torch::rand({1, 3, 5, 6}).transpose(2, 3);
   EXPECT_TRUE(torch::allclose(plain.run(wide), plain.run(wide.contiguous())));
-}
-
-TEST(FusedGraph, LargestDifference) {
-  // Informational: the largest difference (relative to output magnitude >= 1) of the tests above.
-  std::printf("fused graph: largest difference to graph::run %.3g\n", largest_diff);
-  EXPECT_LE(largest_diff, 1e-4);
 }
