@@ -4,7 +4,10 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <ctime>
+#include <functional>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <unordered_map>
 
@@ -91,6 +94,135 @@ struct Call {
 template <class PrimitiveDesc>
 memory::desc scratchpad_of(const PrimitiveDesc& pd) {
   return pd.scratchpad_desc();
+}
+
+// ---- implementation choice ---------------------------------------------------------------------
+// oneDNN's first choice for a convolution is not always its fastest at these widths: on AVX-512
+// with nhwc it picks the brgemm kernels, which measured up to 1.7x slower than its direct jit
+// kernels for 20..40 channels (and faster for others). So each distinct convolution problem
+// times every non-reference implementation once and keeps the fastest. The timing runs on one
+// thread and counts that thread's CPU time: on a shared machine, wall time of a parallel run
+// mostly measures who else was scheduled.
+
+std::string post_ops_key(const dnnl::post_ops& post) {
+  std::string key;
+  for (int i = 0; i < post.len(); ++i) {
+    if (post.kind(i) == dnnl::primitive::kind::sum) {
+      key += " sum";
+    } else if (post.kind(i) == dnnl::primitive::kind::eltwise) {
+      float scale, alpha, beta;
+      dnnl::algorithm algorithm;
+      post.get_params_eltwise(i, scale, algorithm, alpha, beta);
+      key += " eltwise" + std::to_string(static_cast<int>(algorithm)) + ":" + std::to_string(alpha);
+    } else {
+      dnnl::algorithm algorithm;
+      memory::desc operand;
+      post.get_params_binary(i, algorithm, operand);
+      key += " binary" + std::to_string(static_cast<int>(algorithm)) + dims_string(operand.dims());
+    }
+  }
+  return key;
+}
+
+double thread_cpu_ms(const std::function<void()>& f) {
+  const auto now = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+  };
+  const double start = now();
+  f();
+  return now() - start;
+}
+
+void fill(const memory& m, float value) {
+  auto* p = static_cast<float*>(m.get_data_handle());
+  std::fill(p, p + m.get_desc().get_size() / sizeof(float), value);
+}
+
+// oneDNN sizes its work split when a primitive descriptor is made: descriptors made inside this
+// scope run on the calling thread alone.
+class SingleThread {
+ public:
+  SingleThread() : threads_(torch::get_num_threads()) { torch::set_num_threads(1); }
+  ~SingleThread() { torch::set_num_threads(threads_); }
+  SingleThread(const SingleThread&) = delete;
+  SingleThread& operator=(const SingleThread&) = delete;
+
+ private:
+  int threads_;
+};
+
+// The implementation to use for the convolution `desc` with `attr`, among those behind `pd`
+// (oneDNN's first choice); `operands` are the descriptors of its post-op operands by argument
+// and `key` names the problem.
+dnnl::convolution_forward::primitive_desc fastest_convolution(const dnnl::convolution_forward::desc& desc,
+                                                              const dnnl::primitive_attr& attr,
+                                                              const dnnl::convolution_forward::primitive_desc& pd,
+                                                              const std::vector<std::pair<int, memory::desc>>& operands,
+                                                              const std::string& key, const dnnl::engine& engine,
+                                                              dnnl::stream& stream) {
+  static std::mutex mutex;
+  static std::map<std::string, std::string> chosen;  // problem -> implementation, for the process
+  std::vector<dnnl::convolution_forward::primitive_desc> candidates;
+  for (auto it = pd;;) {
+    if (!is_reference(it.impl_info_str())) candidates.push_back(it);
+    if (!it.next_impl()) break;
+  }
+  const auto named = [&](const std::string& impl) {
+    for (const auto& c : candidates)
+      if (impl == c.impl_info_str()) return c;
+    return pd;
+  };
+  if (candidates.size() < 2) return pd;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = chosen.find(key); it != chosen.end()) return named(it->second);
+  }
+  std::string best_impl = pd.impl_info_str();
+  {
+    SingleThread single;
+    std::unordered_map<int, memory> shared = {{DNNL_ARG_SRC, memory(pd.src_desc(), engine)},
+                                              {DNNL_ARG_DST, memory(pd.dst_desc(), engine)}};
+    if (pd.bias_desc()) shared[DNNL_ARG_BIAS] = memory(pd.bias_desc(), engine);
+    for (const auto& [arg, md] : operands) shared[arg] = memory(md, engine);
+    for (auto& [arg, m] : shared) fill(m, 0.5f);
+    struct Trial {
+      std::string impl;
+      dnnl::convolution_forward primitive;
+      std::unordered_map<int, memory> args;
+      double best = 0;
+    };
+    std::vector<Trial> trials;
+    dnnl::convolution_forward::primitive_desc one(desc, attr, engine, /*allow_empty=*/true);
+    for (bool more = static_cast<bool>(one); more; more = one.next_impl()) {
+      const std::string impl = one.impl_info_str();
+      if (is_reference(impl) || named(impl).impl_info_str() != impl) continue;
+      Trial t{impl, dnnl::convolution_forward(one), shared};
+      t.args[DNNL_ARG_WEIGHTS] = memory(one.weights_desc(), engine);
+      fill(t.args[DNNL_ARG_WEIGHTS], 0.01f);
+      if (one.scratchpad_desc().get_size() > 0) t.args[DNNL_ARG_SCRATCHPAD] = memory(one.scratchpad_desc(), engine);
+      trials.push_back(std::move(t));
+    }
+    // Best of three runs each; after the first, candidates over twice the best so far stop.
+    double best = 1e300;
+    for (int round = 0; round < 3; ++round)
+      for (auto& t : trials) {
+        if (round > 0 && t.best > 2 * best) continue;
+        const double ms = thread_cpu_ms([&] {
+          t.primitive.execute(stream, t.args);
+          stream.wait();
+        });
+        t.best = round == 0 ? ms : std::min(t.best, ms);
+        if (t.best < best) {
+          best = t.best;
+          best_impl = t.impl;
+        }
+      }
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  chosen[key] = best_impl;
+  return named(best_impl);
 }
 
 // LibTorch fallback: the inputs are reordered into dense NCHW tensors, the result back.
@@ -413,6 +545,7 @@ class Compiler {
       step.info.ops = {op.name};
     }
     const int out = chain_end(op.output, chain);
+    if (in_place && !options_.sum_in_place) return false;
     const auto [summed, residual] = in_place ? in_place_add(i, chain, parts.size() > 1) : std::pair{-1, -1};
     if (in_place && summed < 0) return false;
     if (summed >= 0) {
@@ -442,8 +575,18 @@ class Compiler {
           dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, md(parts[k].value), weight_any,
           bias_md, md(out), {op.stride, op.stride}, {op.dilation - 1, op.dilation - 1}, {op.padding, op.padding},
           {op.padding, op.padding});
-      const dnnl::convolution_forward::primitive_desc pd(desc, attr(post), p_.engine, /*allow_empty=*/true);
+      dnnl::convolution_forward::primitive_desc pd(desc, attr(post), p_.engine, /*allow_empty=*/true);
       if (!pd) return false;
+      if (options_.tune) {
+        std::vector<std::pair<int, memory::desc>> operands;
+        for (const auto& a : call.values) operands.emplace_back(a.arg, md(a.value));
+        for (const auto& [arg, m] : call.args) operands.emplace_back(arg, m.get_desc());
+        const std::string key = "conv " + dims_string(md(parts[k].value).dims()) + " " +
+                                std::to_string(static_cast<int>(tag_)) + " w" + dims_string(weight_dims) + " s" +
+                                std::to_string(op.stride) + " p" + std::to_string(op.padding) + " d" +
+                                std::to_string(op.dilation) + (bias ? " bias" : "") + post_ops_key(post);
+        pd = fastest_convolution(desc, attr(post), pd, operands, key, p_.engine, p_.stream);
+      }
       add_implementation(step, pd.impl_info_str());
       Call made = make_call<dnnl::convolution_forward::primitive_desc, dnnl::convolution_forward>(pd);
       made.args = std::move(call.args);

@@ -1,26 +1,28 @@
 #pragma once
 // Fast inference of an inference graph (graph.h) with oneDNN primitives instead of the
 // interpreter's one-LibTorch-call-per-op:
-//   - convolutions get their weights reordered once into the layout oneDNN picks for them;
-//   - activations stay in one layout between ops (channels-last by default: on AVX-512 it
-//     selects the brgemm convolutions and needs no channel padding at widths like 20);
+//   - convolutions get their weights reordered once into the layout their kernel asks for;
+//     among oneDNN's kernels for a convolution the fastest is measured once per problem;
+//   - activations stay in one layout between ops (channels-last by default: no channel padding
+//     at widths like 20 or 13, and jit kernels for every op PAN needs);
 //   - the element-wise ops after a convolution (ReLU, LeakyReLU, sigmoid, a residual add, an
 //     attention product, a channel affine, and chains of them) become its post-ops, when the
-//     intermediate values have no other consumer and oneDNN has a jit kernel for the chain;
+//     intermediate values have no other consumer and oneDNN has a jit kernel for the chain; a
+//     residual nothing reads afterwards is summed into in place;
 //   - a concatenation read only by 1x1 convolutions is never built: each such convolution runs
-//     once per part and sums the parts in place (sum post-op);
+//     once per part and sums the parts in its output (sum post-op);
 //   - resizes (nearest, bilinear), average pooling, pixel shuffle and the remaining element-wise
 //     ops are oneDNN primitives; bicubic resizing goes through graph::apply_resize (LibTorch).
-// The result equals graph::run up to float rounding.
+// The result equals graph::run up to float rounding (different summation orders).
 //
 //   FusedGraph fast(net->describe());         // snapshot of the weights
 //   auto sr = fast.run(lr_color);             // [N, 3, s*h, s*w], contiguous NCHW float32
 //
 // The object copies the graph's tensors when constructed: it does not see later changes to the
 // network (training, pruning, loading weights); construct a new one then. The first run for an
-// input size (N, h, w) compiles a plan (primitives, weight reorders, buffers); plans for the
-// last few sizes are kept. Threads are oneDNN's OpenMP threads (torch::set_num_threads). One run
-// at a time per object (plans own their buffers). No autograd.
+// input size (N, h, w) compiles a plan (kernel choice, primitives, weight reorders, buffers);
+// plans for the last few sizes are kept. Threads are oneDNN's OpenMP threads
+// (torch::set_num_threads). One run at a time per object (plans own their buffers). No autograd.
 
 #include <torch/types.h>
 
@@ -45,6 +47,11 @@ class FusedGraph {
     Layout layout = Layout::ChannelsLast;
     bool fuse = true;          // post-op fusion; false runs every op as its own primitive
     bool split_concat = true;  // false: concatenations are copied into one buffer
+    bool sum_in_place = true;  // a residual add writes into the residual's buffer (sum post-op) when
+                               // nothing reads the residual later; false: a binary post-op reads it
+    bool tune = true;          // time oneDNN's kernels for each distinct convolution (once per process
+                               // and problem, single-threaded CPU time) and keep the fastest;
+                               // false: oneDNN's first choice
     size_t cached_plans = 4;   // plans kept for different input sizes
   };
 

@@ -180,18 +180,18 @@ TEST_F(FusedGraphTest, EveryOptionComputesTheSame) {
     SRNetwork net = build(spec, ++seed);
     const graph::Graph g = net->describe();
     const Inputs in = random_of(spec, 2, 7, 9);
-    for (auto layout : {FusedGraph::Layout::ChannelsLast, FusedGraph::Layout::Blocked})
-      for (bool fuse : {true, false})
-        for (bool split : {true, false}) {
-          SCOPED_TRACE(spec.backbone + " blocked " + std::to_string(layout == FusedGraph::Layout::Blocked) + " fuse " +
-                       std::to_string(fuse) + " split " + std::to_string(split));
-          FusedGraph::Options options;
-          options.layout = layout;
-          options.fuse = fuse;
-          options.split_concat = split;
-          FusedGraph fused(g, options);
-          expect_equal_outputs(fused, g, in);
-        }
+    // The defaults, each option flipped alone, all of them flipped.
+    for (int flipped : {0, 1, 2, 4, 8, 16, 31}) {
+      FusedGraph::Options options;
+      if (flipped & 1) options.layout = FusedGraph::Layout::Blocked;
+      options.fuse ^= static_cast<bool>(flipped & 2);
+      options.split_concat ^= static_cast<bool>(flipped & 4);
+      options.sum_in_place ^= static_cast<bool>(flipped & 8);
+      options.tune ^= static_cast<bool>(flipped & 16);
+      SCOPED_TRACE(spec.backbone + " options flipped " + std::to_string(flipped));
+      FusedGraph fused(g, options);
+      expect_equal_outputs(fused, g, in);
+    }
   }
 }
 
