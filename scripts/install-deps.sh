@@ -8,6 +8,7 @@ packages=(
   libtorch-dev          # LibTorch 1.13 (CPU)
   libopenblas0-openmp   # BLAS for LibTorch: without it libblas.so.3 is the reference BLAS, and every
                         # GEMM-based kernel (NCHW conv backward among them) runs ~10x slower
+  libdnnl-dev           # oneDNN headers and CMake package (the fused inference path)
   libopencv-dev         # image I/O, OpenCV DNN for export verification
   libyaml-cpp-dev libtbb-dev libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -1,0 +1,93 @@
+#pragma once
+// Fast inference of an inference graph (graph.h) with oneDNN primitives instead of the
+// interpreter's one-LibTorch-call-per-op:
+//   - convolutions get their weights reordered once into the layout their kernel asks for;
+//     among oneDNN's kernels for a convolution the fastest is measured once per problem;
+//   - activations stay in one layout between ops (channels-last by default: no channel padding
+//     at widths like 20 or 13, and jit kernels for every op PAN needs);
+//   - the element-wise ops after a convolution (ReLU, LeakyReLU, sigmoid, a residual add, an
+//     attention product, a channel affine, and chains of them) become its post-ops, when the
+//     intermediate values have no other consumer and oneDNN has a jit kernel for the chain; a
+//     residual nothing reads afterwards is summed into in place;
+//   - a concatenation read only by 1x1 convolutions is never built: each such convolution runs
+//     once per part and sums the parts in its output (sum post-op);
+//   - resizes (nearest, bilinear), average pooling, pixel shuffle and the remaining element-wise
+//     ops are oneDNN primitives; bicubic resizing goes through graph::apply_resize (LibTorch).
+// The result equals graph::run up to float rounding (different summation orders).
+//
+//   FusedGraph fast(net->describe());         // snapshot of the weights
+//   auto sr = fast.run(lr_color);             // [N, 3, s*h, s*w], contiguous NCHW float32
+//
+// The object copies the graph's tensors when constructed: it does not see later changes to the
+// network (training, pruning, loading weights); construct a new one then. The first run for an
+// input size (N, h, w) compiles a plan (kernel choice, primitives, weight reorders, buffers);
+// plans for the last few sizes are kept. Threads are oneDNN's OpenMP threads
+// (torch::set_num_threads). One run at a time per object (plans own their buffers). No autograd.
+
+#include <torch/types.h>
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "models/graph.h"
+
+namespace cgsr {
+
+class FusedGraph {
+ public:
+  enum class Layout {
+    ChannelsLast,  // nhwc
+    Blocked,       // nChw16c with AVX-512, nChw8c otherwise (channels padded to the block)
+  };
+  struct Options {
+    Layout layout = Layout::ChannelsLast;
+    bool fuse = true;          // post-op fusion; false runs every op as its own primitive
+    bool split_concat = true;  // false: concatenations are copied into one buffer
+    bool sum_in_place = true;  // a residual add writes into the residual's buffer (sum post-op) when
+                               // nothing reads the residual later; false: a binary post-op reads it
+    bool tune = true;          // time oneDNN's kernels for each distinct convolution (once per process
+                               // and problem, single-threaded CPU time) and keep the fastest;
+                               // false: oneDNN's first choice
+    size_t cached_plans = 4;   // plans kept for different input sizes
+  };
+
+  // What a plan executes, one entry per step, in order (for tests, logs and profiles).
+  struct Step {
+    std::string kind;                // "conv", "binary", "eltwise", "resampling", "torch", ...
+    std::vector<std::string> ops;    // names of the graph ops it computes, the first one leading
+    std::string implementation;      // oneDNN's implementation ("jit:avx512_core", ...) or "torch"
+  };
+
+  explicit FusedGraph(const graph::Graph& graph);
+  FusedGraph(const graph::Graph& graph, Options options);
+  ~FusedGraph();
+  FusedGraph(FusedGraph&&) noexcept;
+  FusedGraph& operator=(FusedGraph&&) noexcept;
+
+  // `inputs` maps every graph input name to an NCHW float32 CPU tensor: graph input i is
+  // [N, C_i, h * f_i, w * f_i] for its width C_i and factor f_i (graph.h). Returns every graph
+  // output, contiguous NCHW. Wrong names, shapes or types throw cgsr::Error.
+  std::vector<std::pair<std::string, torch::Tensor>> run(
+      const std::vector<std::pair<std::string, torch::Tensor>>& inputs);
+  // An SR network's graph: inputs "color" (and "info" when the graph has it), output "image".
+  torch::Tensor run(const torch::Tensor& color, const torch::Tensor& info = {});
+
+  // The steps of the plan the last run used (empty before the first run).
+  const std::vector<Step>& steps() const;
+  std::string plan_string() const;  // one line per step
+  const Options& options() const { return options_; }
+
+ private:
+  struct Plan;
+  Plan& plan_for(const std::vector<std::pair<std::string, torch::Tensor>>& inputs);
+
+  graph::Graph graph_;  // with its own copies of every tensor
+  Options options_;
+  std::list<std::unique_ptr<Plan>> plans_;  // most recently used first
+};
+
+}  // namespace cgsr
