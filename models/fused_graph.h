@@ -49,9 +49,10 @@ class FusedGraph {
     bool split_concat = true;  // false: concatenations are copied into one buffer
     bool sum_in_place = true;  // a residual add writes into the residual's buffer (sum post-op) when
                                // nothing reads the residual later; false: a binary post-op reads it
-    bool tune = true;          // time oneDNN's kernels for each distinct convolution (once per process
-                               // and problem, single-threaded CPU time) and keep the fastest;
-                               // false: oneDNN's first choice
+    bool tune = false;         // time oneDNN's kernels for each distinct convolution (once per process
+                               // and problem, single-threaded CPU time) and keep the fastest. Off by
+                               // default: a choice made by timing can differ between two runs, and
+                               // so could their last bits (evaluations must reproduce exactly)
     size_t cached_plans = 4;   // plans kept for different input sizes
   };
 
