@@ -16,6 +16,16 @@ torch::Tensor forward_in(SRNetworkImpl& net, const torch::Tensor& lr_color, cons
 }
 }  // namespace
 
+InferenceEngine inference_engine_from_name(const std::string& name) {
+  if (name == "fused") return InferenceEngine::Fused;
+  if (name == "libtorch") return InferenceEngine::LibTorch;
+  throw Error("inference engine", "'" + name + "' is not one of: fused, libtorch");
+}
+
+const char* inference_engine_name(InferenceEngine engine) {
+  return engine == InferenceEngine::Fused ? "fused" : "libtorch";
+}
+
 MemoryLayout inference_layout(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
                               MemoryLayout requested) {
   if (requested != MemoryLayout::Auto) return requested;

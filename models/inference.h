@@ -5,6 +5,8 @@
 
 #include <torch/types.h>
 
+#include <string>
+
 #include "models/memory_layout.h"
 #include "models/sr_network.h"
 
@@ -15,6 +17,14 @@ namespace cgsr {
 // full size would cost more than it saves on 1080p frames) and remembered for the process.
 MemoryLayout inference_layout(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,
                               MemoryLayout requested = MemoryLayout::Auto);
+
+// Which implementation runs a trained network's inference.
+enum class InferenceEngine {
+  Fused,     // FusedGraph (fused_graph.h): oneDNN with element-wise ops fused into convolutions
+  LibTorch,  // the modules' forward in the measured layout: the reference the tests compare with
+};
+InferenceEngine inference_engine_from_name(const std::string& name);  // fused | libtorch
+const char* inference_engine_name(InferenceEngine engine);
 
 // [N, 3, s*h, s*w], contiguous NCHW. Puts the network in eval mode.
 torch::Tensor infer(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info = {},

@@ -45,11 +45,17 @@ const Registry<ClassicFactory>& classic_upscalers() {
   return registry;
 }
 
-NetworkUpscaler::NetworkUpscaler(std::string name, SRNetwork network)
-    : name_(std::move(name)), network_(std::move(network)) {}
+NetworkUpscaler::NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine)
+    : name_(std::move(name)), network_(std::move(network)), engine_(engine) {}
 
 torch::Tensor NetworkUpscaler::upscale(const Batch& batch) {
-  return infer(*network_, batch.lr_color, network_->info_input(batch));
+  const auto info = network_->info_input(batch);
+  if (engine_ == InferenceEngine::LibTorch) return infer(*network_, batch.lr_color, info);
+  if (!fused_) {
+    network_->eval();
+    fused_ = std::make_shared<FusedGraph>(network_->describe());
+  }
+  return fused_->run(batch.lr_color, info);
 }
 
 std::optional<Complexity> NetworkUpscaler::cost(int64_t lr_width, int64_t lr_height) const {

@@ -12,6 +12,8 @@
 
 #include "core/registry.h"
 #include "models/complexity.h"
+#include "models/fused_graph.h"
+#include "models/inference.h"
 #include "models/sr_network.h"
 #include "render_data/batch.h"
 
@@ -43,9 +45,11 @@ class Upscaler {
 using ClassicFactory = std::function<std::unique_ptr<Upscaler>(int scale)>;
 const Registry<ClassicFactory>& classic_upscalers();
 
+// A trained network, run by the fused inference path unless told otherwise. The fused path
+// snapshots the weights at the first upscale(): the network must not change after that.
 class NetworkUpscaler : public Upscaler {
  public:
-  NetworkUpscaler(std::string name, SRNetwork network);
+  NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine = InferenceEngine::Fused);
   std::string name() const override { return name_; }
   int scale() const override { return network_->spec().scale; }
   std::vector<RenderChannel> channels() const override { return network_->input_channels(); }
@@ -56,6 +60,8 @@ class NetworkUpscaler : public Upscaler {
  private:
   std::string name_;
   SRNetwork network_;
+  InferenceEngine engine_;
+  std::shared_ptr<FusedGraph> fused_;  // built at the first upscale()
 };
 
 }  // namespace cgsr

@@ -13,6 +13,7 @@
 #include "export/onnx_writer.h"
 #include "export/onnxruntime_runner.h"
 #include "models/complexity.h"
+#include "models/fused_graph.h"
 #include "models/inference.h"
 #include "models/model_source.h"
 
@@ -27,7 +28,9 @@ config::Schema<BenchOptions> bench_schema() {
   s.field("batch", &BenchOptions::batch, "images per run").range(1, 64);
   s.field("warmup", &BenchOptions::warmup, "untimed runs first").range(0, 1000);
   s.field("runs", &BenchOptions::runs, "timed runs").range(1, 100000);
-  s.field("layout", &BenchOptions::layout, "activation memory layout").one_of({"auto", "nchw", "nhwc"});
+  s.field("engine", &BenchOptions::engine, "inference engine: fused (oneDNN) or libtorch").one_of({"fused", "libtorch"});
+  s.field("layout", &BenchOptions::layout, "activation memory layout of the libtorch engine")
+      .one_of({"auto", "nchw", "nhwc"});
   s.field("layers", &BenchOptions::layers, "also time every layer of the network");
   s.field("json", &BenchOptions::json, "print JSON instead of a table");
   s.field("onnx", &BenchOptions::onnx, "exported ONNX file to time in ONNX Runtime next to our forward pass");
@@ -49,7 +52,8 @@ void setup_bench(CLI::App& app) {
         flag_to_key(sub, flags, "--batch", "batch", "images per run");
         flag_to_key(sub, flags, "--warmup", "warmup", "untimed runs first");
         flag_to_key(sub, flags, "--runs", "runs", "timed runs");
-        flag_to_key(sub, flags, "--layout", "layout", "activation memory layout: auto, nchw or nhwc");
+        flag_to_key(sub, flags, "--engine", "engine", "inference engine: fused or libtorch");
+        flag_to_key(sub, flags, "--layout", "layout", "activation layout of the libtorch engine: auto, nchw or nhwc");
         switch_to_key(sub, flags, "--layers", "layers", "also time every layer of the network");
         switch_to_key(sub, flags, "--json", "json", "print JSON instead of a table");
         flag_to_key(sub, flags, "--onnx", "onnx", "exported ONNX file to time in ONNX Runtime as well");
@@ -124,12 +128,20 @@ BenchTarget model_target(const BenchOptions& options) {
     const int64_t f = net->rit()->info_factor();
     info = torch::rand({options.batch, static_cast<int64_t>(source.spec.rit.info_width()), h * f, w * f});
   }
-  const MemoryLayout layout = inference_layout(*net, color, info, memory_layout_from_name(options.layout));
   BenchTarget t;
   t.name = spec_summary(source.spec);
+  t.macs = complexity(*net, w, h).macs * options.batch;
+  if (inference_engine_from_name(options.engine) == InferenceEngine::Fused) {
+    net->eval();
+    auto fused = std::make_shared<FusedGraph>(net->describe());
+    t.runtime = "cgsr fused";
+    t.detail = "oneDNN";
+    t.run = [fused, color, info] { fused->run(color, info); };
+    return t;
+  }
+  const MemoryLayout layout = inference_layout(*net, color, info, memory_layout_from_name(options.layout));
   t.runtime = "libtorch";
   t.detail = std::string("layout ") + memory_layout_name(layout);
-  t.macs = complexity(*net, w, h).macs * options.batch;
   t.run = [net, color, info, layout]() mutable { infer(*net, color, info, layout); };
   return t;
 }
@@ -217,7 +229,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& options) {
                     {"min_ms", r.latency.min_ms},
                     {"max_ms", r.latency.max_ms},
                     {"gflops", r.gflops}});
-    results["onnxruntime_vs_libtorch"] = r.latency.median_ms / timed.front().latency.median_ms;
+    results["onnxruntime_vs_cgsr"] = r.latency.median_ms / timed.front().latency.median_ms;
   }
   results["results"] = rows;
   if (options.layers) results["layers"] = layer_profile(options);
@@ -233,8 +245,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& options) {
     std::printf("%-40s %-11s %-12s %10.2f %9.2f %9.2f %9.1f %9s\n", r.target.name.c_str(), r.target.runtime.c_str(),
                 r.target.detail.c_str(), r.latency.median_ms, r.latency.min_ms, r.latency.max_ms, r.gflops,
                 format_count(static_cast<double>(r.target.macs)).c_str());
-  if (results.contains("onnxruntime_vs_libtorch"))
-    std::printf("ONNX Runtime median / our median: %.2fx\n", results["onnxruntime_vs_libtorch"].get<double>());
+  if (results.contains("onnxruntime_vs_cgsr"))
+    std::printf("ONNX Runtime median / our median: %.2fx\n", results["onnxruntime_vs_cgsr"].get<double>());
   if (options.layers) {
     std::printf("\nper layer (graph interpreter, NCHW, mean of %d runs; slowest first)\n", options.runs);
     std::printf("%-44s %-14s %9s %7s %9s %9s\n", "layer", "kind", "ms", "share", "GFLOP/s", "MACs");

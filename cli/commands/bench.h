@@ -25,7 +25,8 @@ struct BenchOptions : RunSettings {
   int batch = 1;
   int warmup = 3;
   int runs = 20;
-  std::string layout = "auto";  // auto | nchw | nhwc (memory layout of the activations)
+  std::string engine = "fused";  // fused | libtorch (models/inference.h)
+  std::string layout = "auto";   // auto | nchw | nhwc: activation layout of the libtorch engine
   bool layers = false;          // also time every layer (graph interpreter, NCHW)
   bool json = false;
   std::string onnx;  // an exported ONNX file to time in ONNX Runtime on the same input

@@ -75,11 +75,14 @@ TEST(BenchCommand, TimesAnOnnxFileInOnnxRuntimeNextToOurForward) {
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["results"].size(), 2u);
-  EXPECT_EQ(j["results"][0]["runtime"], "libtorch");
+  EXPECT_EQ(j["results"][0]["runtime"], "cgsr fused");  // the default engine
   EXPECT_EQ(j["results"][1]["runtime"], "onnxruntime");
   EXPECT_GT(j["results"][1]["median_ms"].get<double>(), 0.0);
-  EXPECT_NEAR(j["onnxruntime_vs_libtorch"].get<double>(),
+  EXPECT_NEAR(j["onnxruntime_vs_cgsr"].get<double>(),
               j["results"][1]["median_ms"].get<double>() / j["results"][0]["median_ms"].get<double>(), 1e-9);
+  const auto reference = test::run_cgsr("bench --onnx " + file + " --input 12x10 --engine libtorch --runs 1 --json");
+  ASSERT_EQ(reference.exit_code, 0) << reference.err;
+  EXPECT_EQ(nlohmann::json::parse(reference.out)["results"][0]["runtime"], "libtorch");
   // A fixed-size file timed at another size, or against another model, is refused clearly.
   const auto size = test::run_cgsr("bench --onnx " + file + " --input 16x16 --runs 1");
   EXPECT_EQ(size.exit_code, 2);

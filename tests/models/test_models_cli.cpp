@@ -86,7 +86,7 @@ TEST(ModelsCli, BenchReportsLatencyAndThroughput) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["threads"].get<int>(), 1);
   const auto& row = j["results"][0];
-  EXPECT_EQ(row["runtime"].get<std::string>(), "libtorch");
+  EXPECT_EQ(row["runtime"].get<std::string>(), "cgsr fused");  // the default engine
   EXPECT_GT(row["median_ms"].get<double>(), 0.0);
   EXPECT_LE(row["min_ms"].get<double>(), row["median_ms"].get<double>());
   EXPECT_GE(row["max_ms"].get<double>(), row["median_ms"].get<double>());
