@@ -18,21 +18,6 @@ struct ExportCase {
   ArchSpec spec;
 };
 
-// A fresh RIT fuses with a zero conv (it starts as the plain backbone); random gate and fusion
-// weights make a wrong RIT export visible in the outputs.
-inline SRNetwork build_network(const ArchSpec& spec, uint64_t seed) {
-  torch::manual_seed(seed);
-  SRNetwork net(spec);
-  if (net->has_rit()) {
-    torch::NoGradGuard no_grad;
-    net->rit()->gate.uniform_(0.5, 1.5);
-    net->rit()->fuse->weight.normal_(0, 0.05);
-    net->rit()->fuse->bias.normal_(0, 0.01);
-  }
-  net->eval();
-  return net;
-}
-
 // A spec with smaller, uneven widths and fewer blocks: what static pruning and the search produce.
 inline ArchSpec shrunk_pan(int scale) {
   ArchSpec s = default_spec("pan", scale);

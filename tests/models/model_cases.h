@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "models/arch_spec.h"
+#include "models/sr_network.h"
 
 namespace cgsr::test {
 
@@ -53,6 +54,21 @@ inline std::pair<torch::Tensor, torch::Tensor> random_inputs(const ArchSpec& s, 
     info = torch::rand({n, static_cast<int64_t>(s.rit.info_width()), h * f, w * f});
   }
   return {color, info};
+}
+
+// A fresh RIT fuses with a zero conv (it starts as the plain backbone); random gate and fusion
+// weights make a wrong RIT export visible in the outputs.
+inline SRNetwork build_network(const ArchSpec& spec, uint64_t seed) {
+  torch::manual_seed(seed);
+  SRNetwork net(spec);
+  if (net->has_rit()) {
+    torch::NoGradGuard no_grad;
+    net->rit()->gate.uniform_(0.5, 1.5);
+    net->rit()->fuse->weight.normal_(0, 0.05);
+    net->rit()->fuse->bias.normal_(0, 0.01);
+  }
+  net->eval();
+  return net;
 }
 
 }  // namespace cgsr::test

@@ -17,20 +17,6 @@ namespace {
 
 using Inputs = std::vector<std::pair<std::string, torch::Tensor>>;
 
-// Random gate and fusion weights: a fresh RIT fuses with a zero conv and would not be tested.
-SRNetwork build(const ArchSpec& spec, uint64_t seed) {
-  torch::manual_seed(seed);
-  SRNetwork net(spec);
-  if (net->has_rit()) {
-    torch::NoGradGuard no_grad;
-    net->rit()->gate.uniform_(0.5, 1.5);
-    net->rit()->fuse->weight.normal_(0, 0.1);
-    net->rit()->fuse->bias.normal_(0, 0.05);
-  }
-  net->eval();
-  return net;
-}
-
 Inputs inputs_of(const ArchSpec& spec, int64_t n, int64_t h, int64_t w,
                  const std::function<torch::Tensor(std::vector<int64_t>)>& make) {
   Inputs in = {{"color", make({n, 3, h, w})}};
@@ -75,7 +61,7 @@ void expect_equal_outputs(FusedGraph& fused, const graph::Graph& g, const Inputs
 
 // One image 12x17, then a batch of two (a second plan).
 void expect_network_matches(const ArchSpec& spec, uint64_t seed, FusedGraph::Options options = FusedGraph::Options()) {
-  SRNetwork net = build(spec, seed);
+  SRNetwork net = build_network(spec, seed);
   const graph::Graph g = net->describe();
   FusedGraph fused(g, options);
   expect_equal_outputs(fused, g, random_of(spec, 1, 12, 17));
@@ -177,7 +163,7 @@ TEST_F(FusedGraphTest, EveryOptionComputesTheSame) {
   uint64_t seed = 90;
   for (const ArchSpec& spec : {with_rit(reduced_pan(4), "lr", "concat"), reduced_edsr(3),
                                with_rit(reduced_srcnn(2), "hr_pooled", "concat")}) {
-    SRNetwork net = build(spec, ++seed);
+    SRNetwork net = build_network(spec, ++seed);
     const graph::Graph g = net->describe();
     const Inputs in = random_of(spec, 2, 7, 9);
     // The defaults, each option flipped alone, all of them flipped.
@@ -200,7 +186,7 @@ TEST_F(FusedGraphTest, ExtremeInputs) {
   for (const ArchSpec& spec : {with_rit(default_spec("pan", 2), "lr", "concat"), default_spec("edsr", 3),
                                default_spec("srcnn", 4), with_rit(reduced_pan(4), "hr_pooled", "add")}) {
     SCOPED_TRACE(spec.backbone);
-    SRNetwork net = build(spec, ++seed);
+    SRNetwork net = build_network(spec, ++seed);
     const graph::Graph g = net->describe();
     FusedGraph fused(g);
     for (float value : {0.f, 1.f, 1e3f}) {
@@ -220,7 +206,7 @@ TEST_F(FusedGraphTest, TinyInputsAndRecompilingForNewSizes) {
   for (const ArchSpec& spec : {with_rit(default_spec("pan", 3), "hr_pooled", "concat"), default_spec("edsr", 4),
                                default_spec("srcnn", 2)}) {
     SCOPED_TRACE(spec.backbone);
-    SRNetwork net = build(spec, ++seed);
+    SRNetwork net = build_network(spec, ++seed);
     const graph::Graph g = net->describe();
     FusedGraph::Options options;
     options.cached_plans = 2;
@@ -233,7 +219,7 @@ TEST_F(FusedGraphTest, TinyInputsAndRecompilingForNewSizes) {
 }
 
 TEST_F(FusedGraphTest, SnapshotOfTheWeights) {
-  SRNetwork net = build(default_spec("pan", 2), 160);
+  SRNetwork net = build_network(default_spec("pan", 2), 160);
   FusedGraph fused(net->describe());
   const auto color = torch::rand({1, 3, 6, 7});
   const auto before = fused.run(color);
@@ -248,7 +234,7 @@ TEST_F(FusedGraphTest, SnapshotOfTheWeights) {
 
 // PAN's element-wise ops all end up inside convolutions, and no step needs a reference kernel.
 TEST_F(FusedGraphTest, PanPlanFusesAttentionAndResiduals) {
-  SRNetwork net = build(with_rit(default_spec("pan", 2), "lr", "concat"), 170);
+  SRNetwork net = build_network(with_rit(default_spec("pan", 2), "lr", "concat"), 170);
   const graph::Graph g = net->describe();
   FusedGraph fused(g);
   fused.run(random_of(net->spec(), 1, 8, 8));
@@ -287,7 +273,7 @@ TEST_F(FusedGraphTest, PanPlanFusesAttentionAndResiduals) {
 
 TEST_F(FusedGraphTest, WrongInputsAreErrors) {
   const ArchSpec spec = with_rit(default_spec("pan", 2), "hr_pooled", "concat");
-  SRNetwork net = build(spec, 180);
+  SRNetwork net = build_network(spec, 180);
   FusedGraph fused(net->describe());
   const auto color = torch::rand({1, 3, 6, 5});
   const auto info = torch::rand({1, 6, 12, 10});
@@ -301,7 +287,7 @@ TEST_F(FusedGraphTest, WrongInputsAreErrors) {
   EXPECT_THROW(fused.run(color, torch::rand({2, 6, 12, 10})), Error);                          // batch
   EXPECT_THROW(fused.run(color.to(torch::kDouble), info), Error);                              // type
   EXPECT_THROW(fused.run(torch::rand({1, 3, 0, 5}), torch::rand({1, 6, 0, 10})), Error);       // empty
-  FusedGraph plain(build(default_spec("edsr", 2), 181)->describe());
+  FusedGraph plain(build_network(default_spec("edsr", 2), 181)->describe());
   EXPECT_THROW(plain.run(color, info), Error);  // a network without RIT takes no info
   // Non-contiguous inputs are fine.
   const auto wide = torch::rand({1, 3, 5, 6}).transpose(2, 3);
