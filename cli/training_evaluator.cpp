@@ -38,7 +38,7 @@ uint64_t text_hash(const std::string& text) {
 TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options)
     : parent_(std::move(parent)), data_(data), options_(std::move(options)) {
   const auto val = data_.frames(Split::Val).empty() ? data_.frames(Split::Train) : data_.frames(Split::Val);
-  const Batch b = frame_batch(data_, val.front(), parent_->spec().scale, {});
+  const Batch b = frame_batch(data_, val.front(), parent_->spec().scale, {}, DepthEncoding::Log);
   lr_width_ = b.lr_color.size(3);
   lr_height_ = b.lr_color.size(2);
 }
@@ -58,7 +58,7 @@ CandidateScore TrainingEvaluator::score(SRNetwork network, const ValidationScore
     const auto& spec = network->spec();
     torch::Tensor info;
     if (network->has_rit()) {
-      const int64_t f = spec.rit.source == "hr_pooled" ? spec.scale : 1;
+      const int64_t f = network->rit()->info_factor();
       info = torch::rand({1, spec.rit.info_width(), lr_height_ * f, lr_width_ * f});
     }
     s.latency_ms = measure_latency([&] { infer(*network, color, info); }, 2, 7).median_ms;

@@ -45,8 +45,11 @@ ExportSignature export_signature(const graph::Graph& graph) {
       s.inputs.push_back(make_port(graph, kExportColorInput, name, value));
     else if (name == "info")
       s.inputs.push_back(make_port(graph, kExportInfoInput, name, value));
+    else if (name == "info_hr")
+      s.inputs.push_back(make_port(graph, kExportHrInfoInput, name, value));
     else
-      throw Error("export", "the graph has an input '" + name + "' that no export format knows (expected color, info)");
+      throw Error("export", "the graph has an input '" + name +
+                                "' that no export format knows (expected color, info, info_hr)");
   }
   if (s.inputs.empty() || s.inputs.front().name != kExportColorInput)
     throw Error("export", "the graph has no colour input 'color' as its first input");
@@ -121,6 +124,19 @@ torch::Tensor find_tensor(const NamedTensors& tensors, const std::string& name) 
   for (const auto& [n, t] : tensors)
     if (n == name) return t;
   return {};
+}
+
+const ExportPort* ExportSignature::info_input() const { return inputs.size() > 1 ? &inputs[1] : nullptr; }
+
+NamedTensors export_inputs(const ExportSignature& signature, const torch::Tensor& lr_color, const torch::Tensor& info) {
+  NamedTensors inputs = {{kExportColorInput, lr_color}};
+  if (const ExportPort* port = signature.info_input()) inputs.emplace_back(port->name, info);
+  return inputs;
+}
+
+torch::Tensor info_tensor(const ExportSignature& signature, const NamedTensors& inputs) {
+  const ExportPort* port = signature.info_input();
+  return port ? find_tensor(inputs, port->name) : torch::Tensor();
 }
 
 }  // namespace cgsr

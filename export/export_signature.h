@@ -1,8 +1,9 @@
 #pragma once
 // The interface of an exported network, the same for every format: inputs `lr_color`
-// [N, 3, H, W] and, when the model uses rendering information, `lr_render_info` [N, C, f*H, f*W]
-// (its channels in render_channels.h order; f = 1 for RIT source lr, the scale for hr_pooled);
-// output `sr` [N, 3, s*H, s*W]. Read off the inference graph (models/graph.h), never off modules.
+// [N, 3, H, W] and, when the model uses rendering information, either `lr_render_info`
+// [N, C, H, W] (RIT source lr) or `hr_render_info` [N, C, s*H, s*W] (every other source), its
+// channels in render_channels.h order and depth in the spec's rit.depth_encoding; output `sr`
+// [N, 3, s*H, s*W]. Read off the inference graph (models/graph.h), never off modules.
 
 #include <torch/types.h>
 
@@ -17,19 +18,21 @@ namespace cgsr {
 
 inline constexpr const char* kExportColorInput = "lr_color";
 inline constexpr const char* kExportInfoInput = "lr_render_info";
+inline constexpr const char* kExportHrInfoInput = "hr_render_info";
 inline constexpr const char* kExportOutput = "sr";
 
 struct ExportPort {
-  std::string name;        // lr_color, lr_render_info, sr
-  std::string graph_name;  // the graph's own name: color, info, image
+  std::string name;        // lr_color, lr_render_info or hr_render_info, sr
+  std::string graph_name;  // the graph's own name: color, info or info_hr, image
   int value = -1;          // graph value index
   int64_t channels = 0;
   int64_t factor = 1;                     // spatial size relative to the LR colour input
-  std::vector<std::string> channel_names;  // "depth", "normal", ... for lr_render_info
+  std::vector<std::string> channel_names;  // "depth", "normal", ... for the rendering information
 };
 
 struct ExportSignature {
-  std::vector<ExportPort> inputs;  // lr_color, then lr_render_info when present
+  std::vector<ExportPort> inputs;  // lr_color, then the rendering information when present
+  const ExportPort* info_input() const;  // nullptr without rendering information
   ExportPort output;               // sr
   int64_t scale() const { return output.factor; }
   const ExportPort* find_input(const std::string& name) const;
@@ -54,7 +57,12 @@ NamedTensors random_inputs(const ExportSignature& signature, int64_t width, int6
 // returns that size (width, height). Throws cgsr::Error naming the offending input.
 std::pair<int64_t, int64_t> check_inputs(const ExportSignature& signature, const NamedTensors& inputs);
 
-// The graph's own input list (color/info) for graph::run and SRNetwork::forward.
 torch::Tensor find_tensor(const NamedTensors& tensors, const std::string& name);  // undefined when absent
+
+// The exported inputs of `signature` from a colour tensor and the network's rendering information
+// (SRNetworkImpl::info_input; ignored when the signature has none).
+NamedTensors export_inputs(const ExportSignature& signature, const torch::Tensor& lr_color, const torch::Tensor& info);
+// The rendering information among `inputs` (undefined when the signature has none).
+torch::Tensor info_tensor(const ExportSignature& signature, const NamedTensors& inputs);
 
 }  // namespace cgsr

@@ -17,7 +17,7 @@
 //   ChannelAffine  Mul / Add with [1, C, 1, 1] initializers
 //   Add, Mul       Add, Mul;  Concat -> Concat(axis 1)
 //
-// Inputs `lr_color`, `lr_render_info` and output `sr` as in export_signature.h. With a fixed
+// Inputs `lr_color`, `lr_render_info` or `hr_render_info` and output `sr` as in export_signature.h. With a fixed
 // size, every dimension is a number (batch 1); with `dynamic_size`, batch, height and width are
 // symbolic (the rendering information of an hr_pooled model has its own symbolic height/width,
 // which must be scale x the colour size).

@@ -5,7 +5,7 @@
 // Module::define. The saved file loads with torch::jit::load (LibTorch) and torch.jit.load
 // (Python) and computes with the very kernels our forward uses.
 //
-//   forward(lr_color [, lr_render_info]) -> sr        (export_signature.h)
+//   forward(lr_color [, lr_render_info or hr_render_info]) -> sr        (export_signature.h)
 //
 // Attribute names are the op's module path with '.' written as "__", so
 // "backbone.conv_first" + weight is `self.backbone__conv_first__weight`.

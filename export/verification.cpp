@@ -52,16 +52,14 @@ double max_abs_error(const torch::Tensor& a, const torch::Tensor& b) {
 }
 
 NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch) {
-  NamedTensors inputs = {{kExportColorInput, batch.lr_color}};
-  if (net.has_rit()) inputs.emplace_back(kExportInfoInput, net.info_input(batch));
-  return inputs;
+  return export_inputs(export_signature(net.describe(false)), batch.lr_color, net.info_input(batch));
 }
 
 void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs) {
   const auto signature = export_signature(net.describe(false));
   check_inputs(signature, inputs);
   c.inputs.push_back(inputs);
-  c.expected.push_back(infer(net, find_tensor(inputs, kExportColorInput), find_tensor(inputs, kExportInfoInput)));
+  c.expected.push_back(infer(net, find_tensor(inputs, kExportColorInput), info_tensor(signature, inputs)));
 }
 
 VerifyCase make_verify_case(SRNetworkImpl& net, const ExportedModel& exported,

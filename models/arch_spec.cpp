@@ -56,10 +56,28 @@ YAML::Node Codec<GroupWidths>::encode(const GroupWidths& widths) {
 
 // ---- spec --------------------------------------------------------------------------------------
 
+const std::vector<std::string>& rit_sources() {
+  static const std::vector<std::string> sources = {"lr", "hr_pooled", "hr_unshuffle", "hr_fuse",
+                                                   "hr_unshuffle+hr_fuse"};
+  return sources;
+}
+
 int ArchSpec::group_width(const std::string& group) const {
   if (group == "rit") return rit.width;
+  if (group == "rit_hr") return rit.hr_width;
   if (group == "geometry") return geometry.width;
   return widths.at(group);
+}
+
+void ArchSpec::set_group_width(const std::string& group, int width) {
+  if (group == "rit")
+    rit.width = width;
+  else if (group == "rit_hr")
+    rit.hr_width = width;
+  else if (group == "geometry")
+    geometry.width = width;
+  else
+    widths.set(group, width);
 }
 
 std::vector<RenderChannel> ArchSpec::input_channels() const {
@@ -134,8 +152,14 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   }
   if (spec.rit.width < 1)
     problems.push_back({"rit.width", "must be at least 1, got " + std::to_string(spec.rit.width)});
-  if (spec.rit.source != "lr" && spec.rit.source != "hr_pooled")
-    problems.push_back({"rit.source", "'" + spec.rit.source + "' is not one of: lr, hr_pooled"});
+  if (std::find(rit_sources().begin(), rit_sources().end(), spec.rit.source) == rit_sources().end())
+    problems.push_back({"rit.source", "'" + spec.rit.source + "' is not one of: " + join(rit_sources(), ", ")});
+  if (spec.rit.hr_width < 1)
+    problems.push_back({"rit.hr_width", "must be at least 1, got " + std::to_string(spec.rit.hr_width)});
+  if (std::find(depth_encoding_names().begin(), depth_encoding_names().end(), spec.rit.depth_encoding) ==
+      depth_encoding_names().end())
+    problems.push_back({"rit.depth_encoding",
+                        "'" + spec.rit.depth_encoding + "' is not one of: " + join(depth_encoding_names(), ", ")});
   if (spec.rit.fusion != "concat" && spec.rit.fusion != "add")
     problems.push_back({"rit.fusion", "'" + spec.rit.fusion + "' is not one of: concat, add"});
   if (spec.geometry.enabled && !spec.rit.enabled)
@@ -202,8 +226,12 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("enabled", &RitSpec::enabled, "insert the rendering information transform block");
   rit.field("channels", &RitSpec::channels, "rendering channels the network reads (render_channels.h names)");
   rit.field("width", &RitSpec::width, "features the RIT convolution produces").at_least(1);
-  rit.field("source", &RitSpec::source, "resolution of the rendering information").one_of({"lr", "hr_pooled"});
+  rit.field("source", &RitSpec::source, "where the rendering information comes from and joins the backbone")
+      .one_of(rit_sources());
+  rit.field("hr_width", &RitSpec::hr_width, "features of the HR branch (hr_fuse)").at_least(1);
   rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone").one_of({"concat", "add"});
+  rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network")
+      .one_of(depth_encoding_names());
   return rit;
 }
 
@@ -260,9 +288,12 @@ std::string spec_summary(const ArchSpec& spec) {
   std::string s = spec.backbone + " x" + std::to_string(spec.scale);
   if (spec.colors == "y") s += " (Y)";
   if (spec.rit.enabled) {
-    std::vector<std::string> channels = spec.rit.channels;
-    s += " + rit[" + join(channels, "+") + ", w" + std::to_string(spec.rit.width) + ", " + spec.rit.source + ", " +
-         spec.rit.fusion + "]";
+    const auto& r = spec.rit;
+    std::string widths;
+    if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
+    if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
+    s += " + rit[" + join(r.channels, "+") + widths + ", " + r.source + ", " + r.fusion + ", " + r.depth_encoding +
+         " depth]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

@@ -15,8 +15,11 @@
 //     enabled: true
 //     channels: [depth, normal, normal_angle, edge]
 //     width: 16
-//     source: lr             # lr, or hr_pooled (HR rendering information pooled down)
+//     source: lr             # where the information comes from and where it joins (rit.h):
+//                            #   lr, hr_pooled, hr_unshuffle, hr_fuse, hr_unshuffle+hr_fuse
+//     hr_width: 16           # features of the HR branch (hr_fuse; layer group "rit_hr")
 //     fusion: concat         # concat (feat + 1x1(cat(feat, rit))), or add (feat + 1x1(rit))
+//     depth_encoding: log    # log, linear or zbuffer (render_channels.h DepthEncoding)
 //   geometry:                # training-only head predicting the HR rendering information
 //     enabled: true
 //     width: 16
@@ -59,16 +62,28 @@ struct RitSpec {
   bool enabled = false;
   std::vector<std::string> channels = {"depth", "normal", "normal_angle", "edge"};  // render_channels.h names
   int width = 16;                 // features the RIT convolution produces (layer group "rit")
-  std::string source = "lr";      // lr | hr_pooled
+  std::string source = "lr";      // one of rit_sources()
+  int hr_width = 16;              // features of the HR branch (layer group "rit_hr")
   std::string fusion = "concat";  // concat | add
+  std::string depth_encoding = "log";  // log | linear | zbuffer
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
+  DepthEncoding depth() const { return depth_encoding_from_name(depth_encoding); }
+  // The parts the source asks for: the block at the backbone's feature map (lr, hr_pooled,
+  // hr_unshuffle) and the branch at the HR features (hr_fuse).
+  bool feature_branch() const { return source != "hr_fuse"; }
+  bool hr_branch() const { return source == "hr_fuse" || source == "hr_unshuffle+hr_fuse"; }
+  // Every source except lr reads the rendering information at the output resolution.
+  bool reads_hr() const { return source != "lr"; }
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
-           fusion == o.fusion;
+           hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding;
   }
 };
+
+// The values of rit.source, in the order ablations list them.
+const std::vector<std::string>& rit_sources();
 
 struct GeometrySpec {
   bool enabled = false;
@@ -85,8 +100,9 @@ struct ArchSpec {
   RitSpec rit;
   GeometrySpec geometry;
 
-  // Width of any layer group: backbone groups, "rit" and "geometry".
+  // Width of any layer group: backbone groups, "rit", "rit_hr" and "geometry".
   int group_width(const std::string& group) const;
+  void set_group_width(const std::string& group, int width);
   // Rendering channels the network takes as input (empty without RIT).
   std::vector<RenderChannel> input_channels() const;
   int color_channels() const { return colors == "y" ? 1 : 3; }

@@ -11,6 +11,7 @@
 #include <torch/types.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "models/arch_spec.h"
@@ -38,24 +39,34 @@ struct ReconstructionPorts {
   int hr_features = -1;
 };
 
+// The HR fusion point (the RIT's HR part, rit.h): reconstruct() passes the features it has after
+// its last upsampling, before its last HR convolutions, through this function and goes on with
+// what it returns; an empty function leaves them alone. HrFusionPort is the graph mirror.
+using HrFusion = std::function<torch::Tensor(const torch::Tensor&)>;
+using HrFusionPort = std::function<int(int)>;
+
 class BackboneImpl : public torch::nn::Module {
  public:
   ~BackboneImpl() override = default;
 
   // lr_color: [N, 3, h, w] RGB in [0,1], whatever the spec's `colors`.
   virtual ExtractedFeatures extract(const torch::Tensor& lr_color) = 0;
-  virtual Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip) = 0;
+  virtual Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip,
+                                     const HrFusion& at_hr) = 0;
 
   // Graph mirrors of extract() and reconstruct(); op names are module paths relative to the
   // backbone (the caller opens the "backbone" scope).
   virtual ExtractedPorts describe_extract(graph::Builder& g, int color) const = 0;
-  virtual ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip) const = 0;
+  virtual ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip,
+                                                   const HrFusionPort& at_hr) const = 0;
 
   // The layer group and spatial factor (relative to LR) of the features at the insertion point.
   virtual std::string feature_group() const = 0;
   virtual int64_t feature_factor() const = 0;
   // The layer group of Reconstruction::hr_features.
   virtual std::string hr_feature_group() const = 0;
+  // The layer group of the features at the HR fusion point.
+  virtual std::string hr_fusion_group() const = 0;
 };
 
 }  // namespace cgsr

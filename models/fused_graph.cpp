@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/tensor_checks.h"
+#include "models/sr_network.h"
 
 namespace cgsr {
 namespace {
@@ -982,9 +983,7 @@ std::vector<std::pair<std::string, torch::Tensor>> FusedGraph::run(
 
 torch::Tensor FusedGraph::run(const torch::Tensor& color, const torch::Tensor& info) {
   if (!graph_.has_output("image")) throw Error("fused graph", "the graph has no output 'image'");
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", color}};
-  if (info.defined()) inputs.emplace_back("info", info);
-  for (auto& [name, t] : run(inputs))
+  for (auto& [name, t] : run(network_inputs(graph_, color, info)))
     if (name == "image") return t;
   CGSR_CHECK(false, "fused graph: output 'image' missing");
 }

@@ -74,7 +74,7 @@ class FusedGraph {
   // output, contiguous NCHW. Wrong names, shapes or types throw cgsr::Error.
   std::vector<std::pair<std::string, torch::Tensor>> run(
       const std::vector<std::pair<std::string, torch::Tensor>>& inputs);
-  // An SR network's graph: inputs "color" (and "info" when the graph has it), output "image".
+  // An SR network's graph: inputs "color" (and the RIT's "info" or "info_hr"), output "image".
   torch::Tensor run(const torch::Tensor& color, const torch::Tensor& info = {});
 
   // The steps of the plan the last run used (empty before the first run).

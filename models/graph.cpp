@@ -83,10 +83,10 @@ const Op* Graph::find_op(const std::string& name) const {
 
 // ---- builder -----------------------------------------------------------------------------------
 
-Builder::Scope::Scope(Builder& b, const std::string& name) : builder_(b), previous_(b.prefix_.size()) {
-  b.prefix_ += name + ".";
+Builder::Scope::Scope(Builder& b, const std::string& name, bool from_root) : builder_(b), previous_(b.prefix_) {
+  b.prefix_ = (from_root ? std::string() : b.prefix_) + name + ".";
 }
-Builder::Scope::~Scope() { builder_.prefix_.resize(previous_); }
+Builder::Scope::~Scope() { builder_.prefix_ = previous_; }
 
 std::string Builder::qualified(const std::string& name) const { return prefix_ + name; }
 
@@ -114,9 +114,12 @@ int Builder::input(const std::string& name, Layout layout, int64_t factor) {
 void Builder::output(const std::string& name, int value) { graph_.outputs.emplace_back(name, value); }
 
 int Builder::conv(const std::string& name, int x, const torch::Tensor& weight, const torch::Tensor& bias,
-                  int64_t padding, Layout out, bool trainable) {
+                  int64_t padding, Layout out, bool trainable, int64_t stride) {
   const Value& in = value(x);
   const std::string full = qualified(name);
+  CGSR_CHECK(stride >= 1 && in.factor % stride == 0,
+             "graph: conv " + full + " stride " + std::to_string(stride) + " does not divide its input's factor " +
+                 std::to_string(in.factor));
   CGSR_CHECK(weight.dim() == 4, "graph: conv " + full + " weight must be 4-D");
   CGSR_CHECK(weight.size(1) == layout_width(in.layout),
              "graph: conv " + full + " takes " + std::to_string(weight.size(1)) + " channels but its input " +
@@ -132,8 +135,9 @@ int Builder::conv(const std::string& name, int x, const torch::Tensor& weight, c
   op.weight = weight;
   op.bias = bias;
   op.padding = padding;
+  op.stride = stride;
   op.trainable = trainable;
-  return push(std::move(op), Value{"", std::move(out), in.factor});
+  return push(std::move(op), Value{"", std::move(out), in.factor / stride});
 }
 
 namespace {

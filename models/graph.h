@@ -122,24 +122,28 @@ class Builder {
  public:
   class Scope {
    public:
-    Scope(Builder& b, const std::string& name);
+    Scope(Builder& b, const std::string& name, bool from_root);
     ~Scope();
     Scope(const Scope&) = delete;
     Scope& operator=(const Scope&) = delete;
 
    private:
     Builder& builder_;
-    size_t previous_;
+    std::string previous_;
   };
 
-  Scope scope(const std::string& name) { return Scope(*this, name); }
+  Scope scope(const std::string& name) { return Scope(*this, name, false); }
+  // A scope that ignores the enclosing ones: ops a module writes from inside another module's
+  // description (the RIT's HR part, called back from the backbone's reconstruction).
+  Scope root_scope(const std::string& name) { return Scope(*this, name, true); }
 
   int input(const std::string& name, Layout layout, int64_t factor);
   void output(const std::string& name, int value);
 
-  // A conv whose weight is [out, in, k, k]; `out` must have width out.
+  // A conv whose weight is [out, in, k, k]; `out` must have width out. A stride must divide the
+  // input's factor (the output's factor is the input's divided by it).
   int conv(const std::string& name, int x, const torch::Tensor& weight, const torch::Tensor& bias, int64_t padding,
-           Layout out, bool trainable = true);
+           Layout out, bool trainable = true, int64_t stride = 1);
   int relu(int x);
   int leaky_relu(int x, double negative_slope);
   int sigmoid(int x);

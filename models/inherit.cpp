@@ -34,9 +34,15 @@ std::vector<std::string> inheritance_problems(const ArchSpec& parent, const Arch
     for (const auto& c : child.rit.channels)
       if (std::find(parent.rit.channels.begin(), parent.rit.channels.end(), c) == parent.rit.channels.end())
         p.push_back("rit channel " + c + " is not read by the parent (" + join(parent.rit.channels) + ")");
+    if (child.rit.depth_encoding != parent.rit.depth_encoding)
+      p.push_back("rit.depth_encoding " + child.rit.depth_encoding + " differs from the parent's " +
+                  parent.rit.depth_encoding);
     if (child.rit.width > parent.rit.width)
       p.push_back("rit.width " + std::to_string(child.rit.width) + " exceeds the parent's " +
                   std::to_string(parent.rit.width));
+    if (child.rit.hr_width > parent.rit.hr_width)
+      p.push_back("rit.hr_width " + std::to_string(child.rit.hr_width) + " exceeds the parent's " +
+                  std::to_string(parent.rit.hr_width));
   }
   if (child.geometry.enabled && parent.geometry.enabled && child.geometry.width > parent.geometry.width)
     p.push_back("geometry.width " + std::to_string(child.geometry.width) + " exceeds the parent's " +
@@ -138,7 +144,7 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
   const graph::Graph pg = parent.describe(/*training=*/true);
   const graph::Graph cg = result.network->describe(/*training=*/true);
   for (const auto& [group, channels] : kept)
-    CGSR_CHECK(child_spec.widths.contains(group) || group == "rit" || group == "geometry",
+    CGSR_CHECK(child_spec.widths.contains(group) || group == "rit" || group == "rit_hr" || group == "geometry",
                "inherit: chosen channels for an unknown layer group " + group);
   result.kept = choose_channels(pg, cg, kept);
 

@@ -1,5 +1,7 @@
 #include "models/model_file.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -15,6 +17,19 @@
 
 namespace cgsr {
 namespace {
+
+// Keys added to the spec since a file was written get the value that reproduces the old
+// behaviour: files from before rit.depth_encoding fed the network z-buffer depth.
+std::string with_legacy_defaults(const std::string& spec_yaml) {
+  try {
+    YAML::Node spec = YAML::Load(spec_yaml);
+    if (!spec.IsMap() || !spec["rit"] || !spec["rit"].IsMap() || spec["rit"]["depth_encoding"]) return spec_yaml;
+    spec["rit"]["depth_encoding"] = "zbuffer";
+    return YAML::Dump(spec);
+  } catch (const YAML::Exception&) {
+    return spec_yaml;  // spec_from_yaml reports where it is malformed
+  }
+}
 
 constexpr char kMagic[8] = {'C', 'G', 'S', 'R', 'M', 'O', 'D', 'L'};
 constexpr uint32_t kVersion = 1;
@@ -138,7 +153,7 @@ ModelFileContents read_model_file(const std::filesystem::path& path) {
   std::vector<std::pair<std::string, std::vector<int64_t>>> declared;
   try {
     if (meta.at("format") != "cgsr-model") throw Error(where, "metadata format is not cgsr-model");
-    contents.spec = spec_from_yaml(meta.at("spec").get<std::string>(), where + " (spec)");
+    contents.spec = spec_from_yaml(with_legacy_defaults(meta.at("spec").get<std::string>()), where + " (spec)");
     contents.provenance = provenance_from_json(meta.value("provenance", nlohmann::ordered_json::object()), where);
     for (const auto& t : meta.at("tensors"))
       declared.emplace_back(t.at("name").get<std::string>(), t.at("shape").get<std::vector<int64_t>>());

@@ -6,8 +6,6 @@
 #include "models/layers.h"
 
 namespace cgsr {
-namespace {
-}
 
 graph::Layout info_layout(const std::vector<RenderChannel>& channels) {
   graph::Layout layout;
@@ -15,36 +13,77 @@ graph::Layout info_layout(const std::vector<RenderChannel>& channels) {
   return layout;
 }
 
-RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, std::string feature_group, int64_t feature_channels,
-                           int64_t feature_factor)
-    : concat_(rit.fusion == "concat"),
-      pool_factor_(rit.source == "hr_pooled" ? scale : 1),
-      upsample_factor_(feature_factor),
-      feature_group_(std::move(feature_group)),
-      channels_(rit.render_channels()) {
-  const int64_t c = total_width(channels_);
-  CGSR_CHECK(c > 0 && rit.width > 0, "RIT needs channels and a positive width");
-  gate = register_parameter("gate", torch::ones({c}));
-  conv = register_module("conv", make_conv(c, rit.width, 3));
-  fuse = register_module("fuse", make_conv(concat_ ? feature_channels + rit.width : rit.width, feature_channels, 1));
+namespace {
+
+// features + 1x1(cat(features, x)) or features + 1x1(x), starting at zero.
+torch::nn::Conv2d make_fusion(bool concat, int64_t feature_channels, int64_t width) {
+  auto fuse = make_conv(concat ? feature_channels + width : width, feature_channels, 1);
   zero_conv(fuse);
+  return fuse;
 }
 
-torch::Tensor RitBlockImpl::forward(const torch::Tensor& features, const torch::Tensor& info) {
-  auto x = pool_factor_ > 1 ? graph::apply_avg_pool(info, pool_factor_) : info;
-  x = graph::apply_affine(x, gate, {});
-  x = torch::leaky_relu(conv(x), kLeakySlope);
+}  // namespace
+
+RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, FusionPoint hr_features)
+    : concat_(rit.fusion == "concat"),
+      info_factor_(rit.reads_hr() ? scale : 1),
+      pool_factor_(rit.source == "hr_pooled" ? scale : 1),
+      stride_(rit.source == "hr_unshuffle" || rit.source == "hr_unshuffle+hr_fuse" ? scale : 1),
+      upsample_factor_(features.factor) {
+  const int64_t c = total_width(rit.render_channels());
+  CGSR_CHECK(c > 0 && rit.width > 0 && rit.hr_width > 0, "RIT needs channels and positive widths");
+  gate = register_parameter("gate", torch::ones({c}));
+  if (rit.feature_branch()) {
+    // Space-to-depth + conv 3x3 == a conv of kernel 3s, stride s, padding s on the HR map.
+    conv = register_module("conv", torch::nn::Conv2d(torch::nn::Conv2dOptions(c, rit.width, 3 * stride_)
+                                                         .stride(stride_)
+                                                         .padding(stride_)));
+    fuse = register_module("fuse", make_fusion(concat_, features.channels, rit.width));
+  }
+  if (rit.hr_branch()) {
+    CGSR_CHECK(hr_features.factor == scale, "RIT: the HR fusion point must be at the output resolution");
+    hr_conv = register_module("hr_conv", make_conv(c, rit.hr_width, 3));
+    hr_fuse = register_module("hr_fuse", make_fusion(concat_, hr_features.channels, rit.hr_width));
+  }
+}
+
+torch::Tensor RitBlockImpl::gate_info(const torch::Tensor& info) const {
+  const auto x = pool_factor_ > 1 ? graph::apply_avg_pool(info, pool_factor_) : info;
+  return graph::apply_affine(x, gate, {});
+}
+
+torch::Tensor RitBlockImpl::fuse_features(const torch::Tensor& features, const torch::Tensor& gated) {
+  auto x = torch::leaky_relu(conv(gated), kLeakySlope);
   if (upsample_factor_ > 1) x = graph::apply_resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
   return features + fuse(concat_ ? torch::cat({features, x}, 1) : x);
 }
 
-int RitBlockImpl::describe(graph::Builder& g, int features, int info) const {
-  int x = pool_factor_ > 1 ? g.avg_pool(info, pool_factor_) : info;
-  x = g.affine("gate", x, gate, {}, /*trainable=*/true);
-  x = g.leaky_relu(describe_conv(g, "conv", conv, x, graph::group_layout("rit", conv->weight.size(0))), kLeakySlope);
+torch::Tensor RitBlockImpl::fuse_hr(const torch::Tensor& hr_features, const torch::Tensor& gated) {
+  const auto x = torch::leaky_relu(hr_conv(gated), kLeakySlope);
+  return hr_features + hr_fuse(concat_ ? torch::cat({hr_features, x}, 1) : x);
+}
+
+int RitBlockImpl::describe_gate(graph::Builder& g, int info) const {
+  const int x = pool_factor_ > 1 ? g.avg_pool(info, pool_factor_) : info;
+  return g.affine("gate", x, gate, {}, /*trainable=*/true);
+}
+
+int RitBlockImpl::describe_features(graph::Builder& g, int features, int gated) const {
+  // Kernel 3s, padding s (one LR pixel), stride s.
+  int x = g.conv("conv", gated, conv->weight, conv->bias, /*padding=*/stride_, graph::group_layout("rit", conv->weight.size(0)),
+                 /*trainable=*/true, stride_);
+  x = g.leaky_relu(x, kLeakySlope);
   if (upsample_factor_ > 1) x = g.resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
   const int fused = describe_conv(g, "fuse", fuse, concat_ ? g.concat({features, x}) : x, g.value(features).layout);
   return g.add(features, fused);
+}
+
+int RitBlockImpl::describe_hr(graph::Builder& g, int hr_features, int gated) const {
+  const int x = g.leaky_relu(
+      describe_conv(g, "hr_conv", hr_conv, gated, graph::group_layout("rit_hr", hr_conv->weight.size(0))), kLeakySlope);
+  const int fused =
+      describe_conv(g, "hr_fuse", hr_fuse, concat_ ? g.concat({hr_features, x}) : x, g.value(hr_features).layout);
+  return g.add(hr_features, fused);
 }
 
 }  // namespace cgsr

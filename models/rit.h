@@ -1,17 +1,27 @@
 #pragma once
 // The rendering information transform (RIT) block of CGSR (Fig. 3 of the paper): turns the
-// chosen rendering channels into features and fuses them into the backbone between feature
-// extraction and reconstruction.
+// chosen rendering channels into features and fuses them into the backbone. `rit.source` says
+// where the information comes from and where it joins:
 //
-//   info [N, C, h, w] (source lr) or [N, C, s*h, s*w] (source hr_pooled: s x s average pooling)
-//   -> gate: x[c] * R[c], the regularization layer; an L1 penalty on R lets training switch off
-//      channels a scene does not need, which can then be left out of the spec
-//   -> conv 3x3 (C -> width) -> LeakyReLU 0.2                       (layer group "rit")
-//   -> bilinear upsampling to the feature map when it is at HR (SRCNN)
-//   -> fusion:  concat: features + conv1x1(cat(features, rit))
-//               add:    features + conv1x1(rit)
+//   lr            info [N, C, h, w] (graph input "info"), joins the feature map
+//   hr_pooled     info [N, C, s*h, s*w] ("info_hr") averaged over s x s windows to LR first
+//   hr_unshuffle  info at HR, space-to-depth onto the LR grid (C*s*s channels, lossless), then the
+//                 3x3 conv; written as the equivalent 3s x 3s conv with stride s and padding s
+//                 (same weights, same parameters, any runtime runs it)
+//   hr_fuse       info at HR feeds a branch at the backbone's HR features (after its last
+//                 upsampling, before its last HR convolutions): what the colour cannot tell is
+//                 where geometry edges are at the output resolution (seed 004)
+//   hr_unshuffle+hr_fuse  both, from the one HR input (multi-scale)
 //
-// The fusion conv starts at zero, so a network with a fresh RIT computes exactly what its
+// Each part is gate -> conv -> LeakyReLU 0.2 -> fusion:
+//   gate: x[c] * R[c], the regularization layer, shared by both parts; an L1 penalty on R lets
+//         training switch off channels a scene does not need, which can then be left out
+//   feature part: conv (C -> width, layer group "rit"), bilinear upsampling when the feature
+//         map is at HR (SRCNN); fusion into the feature map
+//   HR part: conv 3x3 (C -> hr_width, layer group "rit_hr"); fusion into the HR features
+//   fusion concat: features + conv1x1(cat(features, rit)); add: features + conv1x1(rit)
+//
+// Every fusion conv starts at zero, so a network with a fresh RIT computes exactly what its
 // backbone computes (x + 0 == x), and training starts from the pretrained behaviour.
 
 #include <torch/nn/module.h>
@@ -26,28 +36,44 @@ namespace cgsr {
 // The layout of a rendering-information tensor: one fixed segment per named channel.
 graph::Layout info_layout(const std::vector<RenderChannel>& channels);
 
+// Where a part of the RIT joins the backbone: the layer group, width and spatial factor
+// (relative to LR) of the features there.
+struct FusionPoint {
+  std::string group;
+  int64_t channels = 0;
+  int64_t factor = 1;
+};
+
 class RitBlockImpl : public torch::nn::Module {
  public:
-  // `feature_group`/`feature_channels`/`feature_factor` describe the backbone's feature map.
-  RitBlockImpl(const RitSpec& rit, int scale, std::string feature_group, int64_t feature_channels,
-               int64_t feature_factor);
+  RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, FusionPoint hr_features);
 
-  torch::Tensor forward(const torch::Tensor& features, const torch::Tensor& info);
-  // `info` is the graph input holding the rendering information.
-  int describe(graph::Builder& g, int features, int info) const;
+  // The gated information both parts read (hr_pooled: pooled first, as the gate always was).
+  torch::Tensor gate_info(const torch::Tensor& info) const;
+  torch::Tensor fuse_features(const torch::Tensor& features, const torch::Tensor& gated);
+  torch::Tensor fuse_hr(const torch::Tensor& hr_features, const torch::Tensor& gated);
+  // Graph mirrors; `info` is the graph input holding the rendering information.
+  int describe_gate(graph::Builder& g, int info) const;
+  int describe_features(graph::Builder& g, int features, int gated) const;
+  int describe_hr(graph::Builder& g, int hr_features, int gated) const;
 
-  // Resolution of the expected info tensor relative to LR: 1 (lr) or scale (hr_pooled).
-  int64_t info_factor() const { return pool_factor_; }
+  bool has_feature_branch() const { return !conv.is_empty(); }
+  bool has_hr_branch() const { return !hr_conv.is_empty(); }
+  // The graph input's name and resolution relative to LR: "info" and 1 for lr, else "info_hr"
+  // and the scale.
+  const char* input_name() const { return info_factor_ > 1 ? "info_hr" : "info"; }
+  int64_t info_factor() const { return info_factor_; }
 
   torch::Tensor gate;  // [C], R_i of the paper, initialized to 1
-  torch::nn::Conv2d conv{nullptr}, fuse{nullptr};
+  torch::nn::Conv2d conv{nullptr}, fuse{nullptr};        // the feature part
+  torch::nn::Conv2d hr_conv{nullptr}, hr_fuse{nullptr};  // the HR part
 
  private:
   bool concat_;
-  int64_t pool_factor_;     // 1 or scale
-  int64_t upsample_factor_;  // 1 or the feature map's factor
-  std::string feature_group_;
-  std::vector<RenderChannel> channels_;
+  int64_t info_factor_;      // 1 (lr) or the scale
+  int64_t pool_factor_;      // hr_pooled: the scale
+  int64_t stride_;           // hr_unshuffle: the scale
+  int64_t upsample_factor_;  // the feature map's factor
 };
 TORCH_MODULE(RitBlock);
 

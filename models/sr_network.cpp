@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
+
 #include "core/error.h"
 #include "core/tensor_checks.h"
 #include "core/text.h"
@@ -11,10 +13,13 @@ namespace cgsr {
 
 SRNetworkImpl::SRNetworkImpl(const ArchSpec& spec) : spec_(resolve_spec(spec)) {
   backbone_ = register_module("backbone", backbone_registry().get(spec_.backbone).build(spec_));
-  if (spec_.rit.enabled)
-    rit_ = register_module("rit", RitBlock(spec_.rit, spec_.scale, backbone_->feature_group(),
-                                           spec_.group_width(backbone_->feature_group()),
-                                           backbone_->feature_factor()));
+  if (spec_.rit.enabled) {
+    const auto& b = *backbone_;
+    rit_ = register_module(
+        "rit", RitBlock(spec_.rit, spec_.scale,
+                        FusionPoint{b.feature_group(), spec_.group_width(b.feature_group()), b.feature_factor()},
+                        FusionPoint{b.hr_fusion_group(), spec_.group_width(b.hr_fusion_group()), spec_.scale}));
+  }
   if (spec_.geometry.enabled)
     geometry_ = register_module("geometry", GeometryHead(spec_.group_width(backbone_->hr_feature_group()),
                                                          spec_.geometry.width, spec_.input_channels()));
@@ -34,18 +39,23 @@ void SRNetworkImpl::check_inputs(const torch::Tensor& lr_color, const torch::Ten
                              ", got " + (info.defined() ? shape_string(info) : std::string("nothing")));
 }
 
-torch::Tensor SRNetworkImpl::forward(const torch::Tensor& lr_color, const torch::Tensor& info) {
+Reconstruction SRNetworkImpl::run(const torch::Tensor& lr_color, const torch::Tensor& info) {
   check_inputs(lr_color, info);
   const auto extracted = backbone_->extract(lr_color);
-  const auto features = has_rit() ? rit_->forward(extracted.features, info) : extracted.features;
-  return backbone_->reconstruct(features, extracted.skip).image;
+  if (!has_rit()) return backbone_->reconstruct(extracted.features, extracted.skip, {});
+  const auto gated = rit_->gate_info(info);
+  const auto features = rit_->has_feature_branch() ? rit_->fuse_features(extracted.features, gated) : extracted.features;
+  HrFusion at_hr;
+  if (rit_->has_hr_branch()) at_hr = [&](const torch::Tensor& hr) { return rit_->fuse_hr(hr, gated); };
+  return backbone_->reconstruct(features, extracted.skip, at_hr);
+}
+
+torch::Tensor SRNetworkImpl::forward(const torch::Tensor& lr_color, const torch::Tensor& info) {
+  return run(lr_color, info).image;
 }
 
 TrainOutput SRNetworkImpl::forward_train(const torch::Tensor& lr_color, const torch::Tensor& info) {
-  check_inputs(lr_color, info);
-  const auto extracted = backbone_->extract(lr_color);
-  const auto features = has_rit() ? rit_->forward(extracted.features, info) : extracted.features;
-  const auto recon = backbone_->reconstruct(features, extracted.skip);
+  const auto recon = run(lr_color, info);
   return {recon.image, has_geometry_head() ? geometry_->forward(recon.hr_features) : torch::Tensor()};
 }
 
@@ -55,34 +65,53 @@ torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
   if (batch.scale != spec_.scale)
     throw Error("batch", "scale x" + std::to_string(batch.scale) + " does not match the model's x" +
                              std::to_string(spec_.scale));
-  const bool hr = spec_.rit.source == "hr_pooled";
+  check_depth_encoding(batch);
+  const bool hr = spec_.rit.reads_hr();
   return pick_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
                        hr ? "hr_info" : "lr_info", "the model");
 }
 
+void SRNetworkImpl::check_depth_encoding(const Batch& batch) const {
+  const auto reads = input_channels();
+  if (std::find(reads.begin(), reads.end(), RenderChannel::Depth) == reads.end() ||
+      batch.depth_encoding == spec_.rit.depth())
+    return;
+  throw Error(spec_summary(spec_), std::string("the batch's depth is ") + depth_encoding_name(batch.depth_encoding) +
+                                       "-encoded, the model reads " + spec_.rit.depth_encoding +
+                                       " (build batches with the model's depth_encoding())");
+}
+
 torch::Tensor SRNetworkImpl::geometry_target(const Batch& batch) const {
   if (!has_geometry_head()) return {};
+  check_depth_encoding(batch);
   return pick_channels(batch.hr_info, batch.channels, input_channels(), "hr_info", "the model");
 }
 
 graph::Graph SRNetworkImpl::describe(bool training) const {
   graph::Builder g;
   const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
-  const int info = has_rit() ? g.input("info", info_layout(input_channels()), rit_->info_factor()) : -1;
+  const int info = has_rit() ? g.input(rit_->input_name(), info_layout(input_channels()), rit_->info_factor()) : -1;
   ExtractedPorts extracted;
   {
     auto scope = g.scope("backbone");
     extracted = backbone_->describe_extract(g, color);
   }
-  int features = extracted.features;
+  int features = extracted.features, gated = -1;
   if (has_rit()) {
     auto scope = g.scope("rit");
-    features = rit_->describe(g, features, info);
+    gated = rit_->describe_gate(g, info);
+    if (rit_->has_feature_branch()) features = rit_->describe_features(g, features, gated);
   }
+  HrFusionPort at_hr;
+  if (has_rit() && rit_->has_hr_branch())
+    at_hr = [&](int hr) {
+      auto scope = g.root_scope("rit");
+      return rit_->describe_hr(g, hr, gated);
+    };
   ReconstructionPorts recon;
   {
     auto scope = g.scope("backbone");
-    recon = backbone_->describe_reconstruct(g, features, extracted.skip);
+    recon = backbone_->describe_reconstruct(g, features, extracted.skip, at_hr);
   }
   g.output("image", recon.image);
   if (training && has_geometry_head()) {
@@ -96,6 +125,17 @@ torch::Tensor SRNetworkImpl::rit_gate() const { return has_rit() ? rit_->gate : 
 
 std::map<std::string, torch::Tensor> SRNetworkImpl::channel_importance() const {
   return cgsr::channel_importance(describe(false));
+}
+
+std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::Graph& graph,
+                                                                  const torch::Tensor& lr_color,
+                                                                  const torch::Tensor& info) {
+  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", lr_color}};
+  for (const char* name : {"info", "info_hr"})
+    if (graph.has_input(name)) inputs.emplace_back(name, info);
+  if (info.defined() && inputs.size() == 1)
+    throw Error("network inputs", "rendering information given to a network without a RIT block");
+  return inputs;
 }
 
 std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph) {

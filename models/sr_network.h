@@ -11,9 +11,9 @@
 //   auto imp = net->channel_importance();             // group -> [width], differentiable
 //   loss += lambda_s * imp.at("block3_a").index_select(0, shrink).sum();   // sum ||S_k||
 //
-// `info` holds the spec's rendering channels (rit.channels, in render_channels.h order) at LR
-// size for rit.source lr, at HR size for hr_pooled; it may be undefined without a RIT. Resizes
-// follow align_corners=False (graph.h).
+// `info` holds the spec's rendering channels (rit.channels, in render_channels.h order, depth in
+// rit.depth_encoding) at LR size for rit.source lr, at HR size for every other source; it may be
+// undefined without a RIT. Resizes follow align_corners=False (graph.h).
 
 #include <torch/nn/module.h>
 #include <torch/types.h>
@@ -44,11 +44,14 @@ class SRNetworkImpl : public torch::nn::Module {
   TrainOutput forward_train(const torch::Tensor& lr_color, const torch::Tensor& info = {});
 
   // What the network takes from a Batch: its rendering channels at the resolution the spec asks
-  // for (undefined without RIT), and the target of the geometry head (the HR channels).
+  // for (undefined without RIT), and the target of the geometry head (the HR channels). The
+  // batch's depth must be in depth_encoding() (an Error says so otherwise).
+  DepthEncoding depth_encoding() const { return spec_.rit.depth(); }
   torch::Tensor info_input(const Batch& batch) const;
   torch::Tensor geometry_target(const Batch& batch) const;
 
-  // The inference graph (graph.h): inputs "color" (+ "info" with RIT), output "image". With
+  // The inference graph (graph.h): inputs "color" (+ the RIT's "info" or "info_hr"), output
+  // "image". With
   // `training`, also the geometry head and its output "geometry".
   graph::Graph describe(bool training = false) const;
 
@@ -69,12 +72,20 @@ class SRNetworkImpl : public torch::nn::Module {
 
  private:
   void check_inputs(const torch::Tensor& lr_color, const torch::Tensor& info) const;
+  void check_depth_encoding(const Batch& batch) const;
+  Reconstruction run(const torch::Tensor& lr_color, const torch::Tensor& info);
   ArchSpec spec_;
   std::shared_ptr<BackboneImpl> backbone_;
   RitBlock rit_{nullptr};
   GeometryHead geometry_{nullptr};
 };
 TORCH_MODULE(SRNetwork);
+
+// The named inputs of an SR network's graph: "color", and the RIT's "info" or "info_hr" (whichever
+// the graph has) bound to `info`.
+std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::Graph& graph,
+                                                                  const torch::Tensor& lr_color,
+                                                                  const torch::Tensor& info);
 
 // Importance of each channel of every prunable group produced in `graph` (see channel_importance).
 std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph);

@@ -54,8 +54,7 @@ FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const s
     return y;
   };
 
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", batch.lr_color}};
-  if (net.has_rit()) inputs.emplace_back("info", net.info_input(batch));
+  const auto inputs = network_inputs(g, batch.lr_color, net.info_input(batch));
   const bool was_training = net.is_training();
   net.eval();
   FrameImportance sums;

@@ -63,9 +63,11 @@ torch::Tensor DynamicPruning::sampler_input(int frame) {
   auto it = inputs_.find(frame);
   if (it != inputs_.end()) return it->second;
   const int scale = network_->spec().scale;
-  const auto info = frame_batch(data_, frame, scale, channels_).lr_info;
+  // The samplers see depth as the network does: at inference both read the one batch.
+  const DepthEncoding depth = network_->depth_encoding();
+  const auto info = frame_batch(data_, frame, scale, channels_, depth).lr_info;
   torch::Tensor previous;
-  if (frame > 0) previous = frame_batch(data_, frame - 1, scale, channels_).lr_info;
+  if (frame > 0) previous = frame_batch(data_, frame - 1, scale, channels_, depth).lr_info;
   const auto input = cgsr::sampler_input(info, previous, channels_, samplers_->options().grid);
   return inputs_.emplace(frame, input).first->second;
 }

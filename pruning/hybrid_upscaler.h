@@ -25,6 +25,7 @@ class HybridUpscaler : public Upscaler {
   std::string name() const override { return name_; }
   int scale() const override { return model_.network->spec().scale; }
   std::vector<RenderChannel> channels() const override { return channels_; }
+  DepthEncoding depth_encoding() const override { return model_.network->depth_encoding(); }
   torch::Tensor upscale(const Batch& batch) override;
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   bool uses_previous_frame() const override { return true; }

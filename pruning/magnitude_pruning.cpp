@@ -10,11 +10,7 @@ Inheritance magnitude_prune(const SRNetworkImpl& net, double keep_rate) {
   child.geometry.enabled = false;
   for (const auto& unit : find_units(net.describe(false)))
     for (size_t i = 0; i < unit.groups.size(); ++i) {
-      const int width = static_cast<int>(kept_count(unit.widths[i], keep_rate));
-      if (unit.groups[i] == "rit")
-        child.rit.width = width;
-      else
-        child.widths.set(unit.groups[i], width);
+      child.set_group_width(unit.groups[i], static_cast<int>(kept_count(unit.widths[i], keep_rate)));
     }
   Inheritance result = inherit(net, resolve_spec(child));
   result.network->eval();

@@ -11,7 +11,6 @@ namespace cgsr {
 PatternExecutor::PatternExecutor(const SRNetworkImpl& net, PatternPool pool) : pool_(std::move(pool)) {
   torch::NoGradGuard no_grad;
   const graph::Graph g = net.describe(false);
-  has_info_ = g.has_input("info");
   const auto units = find_units(g);
   CGSR_CHECK(units.size() == pool_.units.size(), "pattern executor: the pool does not match the network's units");
   working_ = g;
@@ -76,9 +75,7 @@ torch::Tensor PatternExecutor::run(const torch::Tensor& lr_color, const torch::T
                                    const std::vector<int>& choice) {
   torch::NoGradGuard no_grad;
   apply(choice);
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", lr_color}};
-  if (has_info_) inputs.emplace_back("info", info);
-  for (const auto& [name, value] : graph::run(working_, inputs))
+  for (const auto& [name, value] : graph::run(working_, network_inputs(working_, lr_color, info)))
     if (name == "image") return value;
   throw Error("pattern executor", "the graph has no image output", ErrorKind::Internal);
 }

@@ -46,7 +46,6 @@ class PatternExecutor {
   void apply(const std::vector<int>& choice);
 
   PatternPool pool_;
-  bool has_info_ = false;
   graph::Graph working_;
   std::vector<std::vector<Prepared>> prepared_;  // [unit][pattern]
   std::vector<int> current_;                    // pattern applied per unit (-1: none yet)

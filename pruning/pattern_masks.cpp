@@ -56,9 +56,7 @@ torch::Tensor PatternMasks::forward(const torch::Tensor& lr_color, const torch::
     const auto mask = torch::cat(parts, 1);
     return y * mask.view({n, mask.size(1), 1, 1});
   };
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", lr_color}};
-  if (graph_.has_input("info")) inputs.emplace_back("info", info);
-  for (const auto& [name, value] : graph::run(graph_, inputs, nullptr, observe))
+  for (const auto& [name, value] : graph::run(graph_, network_inputs(graph_, lr_color, info), nullptr, observe))
     if (name == "image") return value;
   throw Error("pattern masks", "the graph has no image output", ErrorKind::Internal);
 }

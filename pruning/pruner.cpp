@@ -59,7 +59,7 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   {
     Progress progress("importance", static_cast<int64_t>(pool_frames.size()));
     for (int f : pool_frames) {
-      importance.push_back(frame_importance(*net, frame_batch(data, f, scale, net->input_channels()), units, method));
+      importance.push_back(frame_importance(*net, frame_batch(data, f, scale, net->input_channels(), net->depth_encoding()), units, method));
       progress.advance();
     }
     progress.finish();

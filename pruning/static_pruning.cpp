@@ -22,7 +22,11 @@ std::vector<std::pair<std::string, double>> rit_channel_contributions(const SRNe
   if (!net.has_rit()) return out;
   torch::NoGradGuard no_grad;
   const auto gate = net.rit_gate().abs();
-  const auto reads = net.rit()->conv->weight.abs().sum({0, 2, 3});  // per info position
+  // Per info position: what the RIT's convolutions (feature and HR part) read from it.
+  const auto& rit = *net.rit();
+  auto reads = torch::zeros_like(gate);
+  if (rit.has_feature_branch()) reads += rit.conv->weight.abs().sum({0, 2, 3});
+  if (rit.has_hr_branch()) reads += rit.hr_conv->weight.abs().sum({0, 2, 3});
   const auto per_position = (gate * reads).to(torch::kDouble);
   int64_t offset = 0;
   for (auto c : net.input_channels()) {
@@ -68,10 +72,7 @@ StaticPruning static_prune(const SRNetworkImpl& net, const PatternPool& pool,
     for (size_t i = 0; i < u.unit.groups.size(); ++i) {
       const auto& g = u.unit.groups[i];
       const auto& kept = result.channels.at(g);
-      if (g == "rit")
-        child.rit.width = static_cast<int>(kept.size());
-      else
-        child.widths.set(g, static_cast<int>(kept.size()));
+      child.set_group_width(g, static_cast<int>(kept.size()));
       std::vector<int64_t> removed;
       for (int64_t c = 0, k = 0; c < u.unit.widths[i]; ++c) {
         if (k < static_cast<int64_t>(kept.size()) && kept[k] == c)

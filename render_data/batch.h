@@ -17,6 +17,7 @@ struct Batch {
   torch::Tensor hr_color;  // [N, 3, s*h, s*w]
   torch::Tensor hr_info;   // [N, C, s*h, s*w]
   std::vector<RenderChannel> channels;
+  DepthEncoding depth_encoding = DepthEncoding::Log;  // of the depth channel in lr_info/hr_info
   std::vector<int> frames;  // frame index of each item in the sequence
   int scale = 2;
 };

@@ -26,12 +26,13 @@ std::vector<RenderChannel> Frame::channels() const {
 
 torch::Tensor Frame::color_float() const { return color.to(torch::kFloat32).div_(255.0f); }
 
-torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, double near_plane, double far_plane) const {
+torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncoding depth_encoding, double near_plane,
+                          double far_plane) const {
   std::vector<torch::Tensor> parts;
   for (auto c : channels) {
     if (!has(c)) throw Error("frame", "has no '" + channel_name(c) + "' channel");
     switch (c) {
-      case RenderChannel::Depth: parts.push_back(normalize_depth(depth, near_plane, far_plane)); break;
+      case RenderChannel::Depth: parts.push_back(encode_depth(depth, near_plane, far_plane, depth_encoding)); break;
       case RenderChannel::Normal: parts.push_back(normal.to(torch::kFloat32)); break;
       case RenderChannel::NormalAngle: parts.push_back(normal_angle.to(torch::kFloat32)); break;
       case RenderChannel::Edge: parts.push_back(edge.to(torch::kFloat32)); break;

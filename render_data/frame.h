@@ -27,9 +27,10 @@ struct Frame {
   std::vector<RenderChannel> channels() const;  // present channels, in the fixed order
   // float32 [3,H,W] in [0,1].
   torch::Tensor color_float() const;
-  // float32 [total_width(channels),H,W] in the contract's form (depth through normalize_depth).
+  // float32 [total_width(channels),H,W] in the contract's form (depth through encode_depth).
   // Throws cgsr::Error when a requested channel is missing.
-  torch::Tensor info(const std::vector<RenderChannel>& channels, double near_plane, double far_plane) const;
+  torch::Tensor info(const std::vector<RenderChannel>& channels, DepthEncoding depth, double near_plane,
+                     double far_plane) const;
   size_t bytes() const;  // memory held by the tensors
 };
 

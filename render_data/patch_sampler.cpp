@@ -47,13 +47,14 @@ struct Item {
 };
 
 Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int s,
-               const std::vector<RenderChannel>& channels, double near_plane, double far_plane, const Augmentation* aug) {
+               const std::vector<RenderChannel>& channels, DepthEncoding depth, double near_plane, double far_plane,
+               const Augmentation* aug) {
   const Frame l = crop(lr, x, y, w, h), H = crop(hr, s * x, s * y, s * w, s * h);
   Item it;
   it.lr_color = l.color_float();
   it.hr_color = H.color_float();
-  it.lr_info = l.info(channels, near_plane, far_plane);
-  it.hr_info = H.info(channels, near_plane, far_plane);
+  it.lr_info = l.info(channels, depth, near_plane, far_plane);
+  it.hr_info = H.info(channels, depth, near_plane, far_plane);
   if (aug) {
     it.lr_color = augment_image(it.lr_color, *aug);
     it.hr_color = augment_image(it.hr_color, *aug);
@@ -63,8 +64,10 @@ Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int
   return it;
 }
 
-Batch stack(std::vector<Item>& items, const std::vector<RenderChannel>& channels, std::vector<int> frames, int scale) {
+Batch stack(std::vector<Item>& items, const std::vector<RenderChannel>& channels, DepthEncoding depth,
+            std::vector<int> frames, int scale) {
   Batch b;
+  b.depth_encoding = depth;
   std::vector<torch::Tensor> lc, li, hc, hi;
   for (auto& it : items) {
     lc.push_back(it.lr_color);
@@ -140,12 +143,12 @@ Batch PatchSampler::build(int64_t k) const {
     const Choice& c = choices[i];
     const auto l = data_.frame(c.frame, lr_), h = data_.frame(c.frame, hr_);
     const Augmentation aug = Augmentation::from_index(c.aug);
-    items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, info.near_plane, info.far_plane,
-                         o.augment ? &aug : nullptr);
+    items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
+                         info.near_plane, info.far_plane, o.augment ? &aug : nullptr);
   });
   std::vector<int> frames;
   for (const auto& c : choices) frames.push_back(c.frame);
-  return stack(items, o.channels, frames, o.scale);
+  return stack(items, o.channels, o.depth_encoding, frames, o.scale);
 }
 
 Batch PatchSampler::next() { return batch(next_); }
@@ -179,14 +182,15 @@ Batch PatchSampler::batch(int64_t k) {
   return std::move(slot->batch);
 }
 
-Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<RenderChannel>& channels, int lr_width) {
+Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<RenderChannel>& channels,
+                  DepthEncoding depth, int lr_width) {
   const auto [lo, hi] = resolution_pair(data, scale, lr_width);
   require_channels(data, channels, lo, hi);
   const auto l = data.frame(frame, lo), h = data.frame(frame, hi);
   const auto& info = data.info();
-  std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, info.near_plane, info.far_plane,
-                                    nullptr)};
-  return stack(items, channels, {frame}, scale);
+  std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, depth, info.near_plane,
+                                    info.far_plane, nullptr)};
+  return stack(items, channels, depth, {frame}, scale);
 }
 
 FrameIterator::FrameIterator(Dataset data, FrameIteratorOptions options) : data_(std::move(data)), options_(std::move(options)) {
@@ -196,7 +200,8 @@ FrameIterator::FrameIterator(Dataset data, FrameIteratorOptions options) : data_
 }
 
 Batch FrameIterator::get(int k) const {
-  return frame_batch(data_, frames_.at(k), options_.scale, options_.channels, data_.resolutions()[lr_].width);
+  return frame_batch(data_, frames_.at(k), options_.scale, options_.channels, options_.depth_encoding,
+                     data_.resolutions()[lr_].width);
 }
 
 }  // namespace cgsr

@@ -10,7 +10,7 @@
 //
 //   FrameIterator frames(data, {/*scale=*/2, Split::Test, channels});
 //   for (int k = 0; k < frames.size(); ++k) { Batch b = frames.get(k); ... }   // N = 1, full frames
-//   Batch f = frame_batch(data, /*frame=*/12, /*scale=*/2, channels);          // any frame by index
+//   Batch f = frame_batch(data, /*frame=*/12, /*scale=*/2, channels, DepthEncoding::Log);  // any frame
 //
 // Patches: a random frame of the split, a random LR window, the HR window exactly `scale` times
 // it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), DESIGN.md). With
@@ -34,6 +34,7 @@ struct PatchSamplerOptions {
   int batch_size = 16;
   Split split = Split::Train;
   std::vector<RenderChannel> channels;  // rendering information in the batch (may be empty)
+  DepthEncoding depth_encoding = DepthEncoding::Log;  // of the depth channel (the reader's, e.g. the model's)
   bool augment = true;
   uint64_t seed = 0;
   int prefetch = 2;  // batches built ahead
@@ -71,12 +72,13 @@ struct FrameIteratorOptions {
   int scale = 2;
   Split split = Split::Test;
   std::vector<RenderChannel> channels;
+  DepthEncoding depth_encoding = DepthEncoding::Log;
   int lr_width = 0;
 };
 
 // One whole frame (N = 1) by frame index, LR/HR picked as in resolution_pair.
 Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<RenderChannel>& channels,
-                  int lr_width = 0);
+                  DepthEncoding depth, int lr_width = 0);
 
 // Whole frames of a split, one Batch (N = 1) per frame, in frame order.
 class FrameIterator {

@@ -5,7 +5,8 @@
 // this order, each channel with the width given here.
 //
 //   name          width  range     meaning
-//   depth           1    [0,1]    normalized depth, z-buffer convention (see normalize_depth)
+//   depth           1    [0,1]    depth in the encoding the consumer asks for (DepthEncoding below;
+//                                 0 at the near plane, 1 at the far plane and for sky)
 //   normal          3    [-1,1]   view-space unit normal (x right, y up, z towards the camera);
 //                                 0 where there is no geometry (sky)
 //   normal_angle    1    [0,1]    angle between the normal and the direction to the camera,
@@ -40,8 +41,21 @@ torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderC
                             const std::vector<RenderChannel>& wanted, const std::string& what,
                             const std::string& reader);
 
-// The one place where linear view-space depth becomes what a network sees: the z-buffer value
-// of a perspective projection, (1/near - 1/z) / (1/near - 1/far), clamped to [0,1]. 0 at the near
+// How linear view depth z becomes the [0,1] value a network sees. A model records its encoding
+// (rit.depth_encoding); data sets always store linear depth, so any encoding can be made.
+//   log      log(z/near) / log(far/near): equal steps per octave of distance, so a room and a
+//            horizon both get a usable range (the default for new networks)
+//   linear   z / far
+//   zbuffer  the z-buffer value (normalize_depth); above 0.95 for most of a scene with a near
+//            plane of a few centimetres, so it carries little signal (kept for older model files)
+// All clamp to [0,1]: 0 at (and before) the near plane, 1 at the far plane and beyond (sky).
+enum class DepthEncoding { Log, Linear, ZBuffer };
+DepthEncoding depth_encoding_from_name(const std::string& name);  // cgsr::Error listing valid names
+const char* depth_encoding_name(DepthEncoding encoding);
+const std::vector<std::string>& depth_encoding_names();
+torch::Tensor encode_depth(const torch::Tensor& linear_depth, double near, double far, DepthEncoding encoding);
+
+// The z-buffer value of a perspective projection, (1/near - 1/z) / (1/near - 1/far), clamped to [0,1]. 0 at the near
 // plane, 1 at the far plane and beyond (sky, z = inf). Finite for any near > 0, far <= inf.
 torch::Tensor normalize_depth(const torch::Tensor& linear_depth, double near, double far);
 // Inverse of normalize_depth for values in [0,1) (1 maps to far).

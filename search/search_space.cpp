@@ -78,6 +78,8 @@ ArchSpec SearchSpace::mutate(const ArchSpec& spec, double rate, std::mt19937_64&
   if (parent_.rit.enabled) {
     if (options_.search_rit_width && u(rng) < rate)
       out.rit.width = mutate_choice(width_choices(parent_.rit.width), out.rit.width, rng);
+    if (options_.search_rit_width && parent_.rit.hr_branch() && u(rng) < rate)
+      out.rit.hr_width = mutate_choice(width_choices(parent_.rit.hr_width), out.rit.hr_width, rng);
     if (options_.search_rit_channels && u(rng) < rate) {
       // Toggle one of the parent's channels, keeping at least one.
       const auto& all = parent_.rit.channels;
@@ -103,6 +105,7 @@ ArchSpec SearchSpace::crossover(const ArchSpec& a, const ArchSpec& b, std::mt199
   out.widths = widths;
   if (parent_.rit.enabled) {
     out.rit.width = coin(rng) ? a.rit.width : b.rit.width;
+    if (parent_.rit.hr_branch()) out.rit.hr_width = coin(rng) ? a.rit.hr_width : b.rit.hr_width;
     std::vector<std::string> channels;
     for (const auto& c : parent_.rit.channels) {
       const auto& from = coin(rng) ? a.rit.channels : b.rit.channels;
@@ -125,6 +128,7 @@ ArchSpec SearchSpace::sample(std::mt19937_64& rng) const {
   out.widths = widths;
   if (parent_.rit.enabled) {
     if (options_.search_rit_width) out.rit.width = any(width_choices(parent_.rit.width));
+    if (options_.search_rit_width && parent_.rit.hr_branch()) out.rit.hr_width = any(width_choices(parent_.rit.hr_width));
     if (options_.search_rit_channels) {
       std::vector<std::string> channels;
       std::bernoulli_distribution coin(0.5);

@@ -112,6 +112,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   if (options.temporal && !temporal)
     spdlog::warn("{}: no motion vectors, temporal error skipped", data.info().root.string());
   const auto channels = temporal ? with_motion(upscaler.channels()) : upscaler.channels();
+  const DepthEncoding depth = upscaler.depth_encoding();
   QualityOptions quality;
   quality.crop_border = options.crop_border;
   quality.y_channel = options.y_channel;
@@ -124,7 +125,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
   const auto upscale_frame = [&](const Batch& b, int frame) {
     if (upscaler.uses_previous_frame() && frame > 0)
-      upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels));
+      upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));
     return upscaler.upscale(b);
   };
   // The last evaluated frame and its output: consecutive frames (a range) reuse it as the
@@ -133,7 +134,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   Batch last_batch;
   torch::Tensor last_sr;
   for (int frame : frames) {
-    const Batch b = frame_batch(data, frame, result.scale, channels);
+    const Batch b = frame_batch(data, frame, result.scale, channels, depth);
     const auto sr = upscale_frame(b, frame).clamp(0.0, 1.0);
     const auto details = upscaler.frame_details();
     if (!torch::isfinite(sr).all().item<bool>())
@@ -152,7 +153,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
     ssim_sum += score.ssim;
     if (temporal && frame > 0) {
       const bool consecutive = last_frame == frame - 1;
-      const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels);
+      const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels, depth);
       const auto prev_sr = consecutive ? last_sr : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
       const auto motion = hr_motion(b);
       score.temporal_error = warping_error(sr, prev_sr, motion);
@@ -177,7 +178,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   // Quality is known before latency, which can take minutes at large sizes.
   spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f} on {} frame(s)", result.name, result.psnr, result.ssim, frames.size());
 
-  const Batch first = frame_batch(data, frames.front(), result.scale, upscaler.channels());
+  const Batch first = frame_batch(data, frames.front(), result.scale, upscaler.channels(), upscaler.depth_encoding());
   result.lr_width = first.lr_color.size(3);
   result.lr_height = first.lr_color.size(2);
   result.cost = upscaler.cost(result.lr_width, result.lr_height);

@@ -171,7 +171,8 @@ ValidationScore Trainer::validate(int step) {
   ValidationScore score;
   score.step = step;
   for (int frame : val_frames_) {
-    const Batch b = in_layout(frame_batch(data_, frame, network_->spec().scale, channels_), layout_);
+    const Batch b =
+        in_layout(frame_batch(data_, frame, network_->spec().scale, channels_, network_->depth_encoding()), layout_);
     const auto out = forward(b, step);
     const auto image = out.image.clamp(0.0, 1.0);
     score.psnr += psnr(image, b.hr_color).item<double>();
@@ -296,6 +297,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.batch_size = schedule_.batch_size;
   sampling.split = Split::Train;
   sampling.channels = channels_;
+  sampling.depth_encoding = network_->depth_encoding();
   sampling.augment = schedule_.augment;
   PatchSampler sampler(data_, sampling);
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).

@@ -26,6 +26,8 @@ class Upscaler {
   virtual int scale() const = 0;
   // Rendering channels the upscaler reads from a Batch (at LR and/or HR as its spec says).
   virtual std::vector<RenderChannel> channels() const { return {}; }
+  // The encoding of the depth channel in those batches.
+  virtual DepthEncoding depth_encoding() const { return DepthEncoding::Log; }
   // [N, 3, s*h, s*w] in [0,1]-ish (not clamped), without autograd.
   virtual torch::Tensor upscale(const Batch& batch) = 0;
   // Parameters and MACs at an LR size; nullopt for classic filters (the paper's "NA").
@@ -53,6 +55,7 @@ class NetworkUpscaler : public Upscaler {
   std::string name() const override { return name_; }
   int scale() const override { return network_->spec().scale; }
   std::vector<RenderChannel> channels() const override { return network_->input_channels(); }
+  DepthEncoding depth_encoding() const override { return network_->depth_encoding(); }
   torch::Tensor upscale(const Batch& batch) override;
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   SRNetwork network() const { return network_; }

@@ -153,11 +153,12 @@ nlohmann::ordered_json layer_profile(const BenchOptions& options) {
   net->eval();
   torch::NoGradGuard no_grad;
   const graph::Graph g = net->describe();
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", torch::rand({options.batch, 3, h, w})}};
+  torch::Tensor info;
   if (net->has_rit()) {
     const int64_t f = net->rit()->info_factor();
-    inputs.emplace_back("info", torch::rand({options.batch, source.spec.rit.info_width(), h * f, w * f}));
+    info = torch::rand({options.batch, source.spec.rit.info_width(), h * f, w * f});
   }
+  const auto inputs = network_inputs(g, torch::rand({options.batch, 3, h, w}), info);
   std::vector<double> total(g.ops.size(), 0.0), once;
   for (int i = 0; i < options.warmup; ++i) graph::run(g, inputs);
   for (int i = 0; i < options.runs; ++i) {

@@ -202,8 +202,7 @@ void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<st
     if (file == onnx_files.end() || !fs::exists(file->second)) continue;
     // The file records its spec; a network of that spec picks its rendering channels from the batch.
     const SRNetwork net(spec_from_yaml(inspect_onnx_file(file->second).metadata_value("cgsr.spec"), file->second.string()));
-    NamedTensors inputs = {{kExportColorInput, frames[i].lr_color}};
-    if (net->has_rit()) inputs.emplace_back(kExportInfoInput, net->info_input(frames[i]));
+    const auto inputs = export_inputs(export_signature(net->describe(false)), frames[i].lr_color, net->info_input(frames[i]));
     jobs.push_back({file->second, {{inputs, /*warmup=*/2, runs}}});
     rows.push_back(i);
   }
@@ -396,7 +395,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
             else
               upscalers.push_back(make_upscaler(file == model_files.end() ? e.name : file->second.string(), e.name,
                                                 backbone.scale));
-            frames.push_back(frame_batch(data, frame, backbone.scale, upscalers.back()->channels()));
+            frames.push_back(frame_batch(data, frame, backbone.scale, upscalers.back()->channels(),
+                                               upscalers.back()->depth_encoding()));
           }
           for (size_t i = 0; i < upscalers.size(); ++i)
             timed.push_back([&, i] { upscalers[i]->upscale(frames[i]); });

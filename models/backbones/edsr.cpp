@@ -67,9 +67,10 @@ ExtractedFeatures EdsrImpl::extract(const torch::Tensor& lr_color) {
   return {body_conv(res) + h, {}};
 }
 
-Reconstruction EdsrImpl::reconstruct(const torch::Tensor& features, const torch::Tensor&) {
+Reconstruction EdsrImpl::reconstruct(const torch::Tensor& features, const torch::Tensor&, const HrFusion& at_hr) {
   auto x = features;
   for (size_t s = 0; s < upsample_.size(); ++s) x = torch::pixel_shuffle(upsample_[s](x), stage_factors_[s]);
+  if (at_hr) x = at_hr(x);
   return {torch::conv2d(tail(x), shift_weight_, mean_), x};
 }
 
@@ -82,7 +83,8 @@ ExtractedPorts EdsrImpl::describe_extract(graph::Builder& g, int color) const {
   return {g.add(describe_conv(g, "body_conv", body_conv, res, graph::group_layout("features", nf)), h), -1};
 }
 
-ReconstructionPorts EdsrImpl::describe_reconstruct(graph::Builder& g, int features, int) const {
+ReconstructionPorts EdsrImpl::describe_reconstruct(graph::Builder& g, int features, int,
+                                                   const HrFusionPort& at_hr) const {
   int x = features;
   for (size_t s = 0; s < upsample_.size(); ++s) {
     const int64_t r = stage_factors_[s];
@@ -92,6 +94,7 @@ ReconstructionPorts EdsrImpl::describe_reconstruct(graph::Builder& g, int featur
                       graph::group_layout(group, conv->weight.size(0) / (r * r), r * r));
     x = g.pixel_shuffle(x, r);
   }
+  if (at_hr) x = at_hr(x);
   const int out = describe_conv(g, "tail", tail, x, graph::fixed_layout("rgb", 3));
   return {g.conv("add_mean", out, shift_weight_, mean_, 0, graph::fixed_layout("rgb", 3), /*trainable=*/false), x};
 }

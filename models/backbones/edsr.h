@@ -39,12 +39,14 @@ class EdsrImpl : public BackboneImpl {
  public:
   explicit EdsrImpl(const ArchSpec& spec);
   ExtractedFeatures extract(const torch::Tensor& lr_color) override;
-  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip) override;
+  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip, const HrFusion& at_hr) override;
   ExtractedPorts describe_extract(graph::Builder& g, int color) const override;
-  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip) const override;
+  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip,
+                                           const HrFusionPort& at_hr) const override;
   std::string feature_group() const override { return "features"; }
   int64_t feature_factor() const override { return 1; }
   std::string hr_feature_group() const override { return upsample_.size() == 2 ? "up2" : "up1"; }
+  std::string hr_fusion_group() const override { return upsample_.size() == 2 ? "up2" : "up1"; }
 
  private:
   std::vector<int64_t> stage_factors_;  // {2}, {3} or {2, 2}

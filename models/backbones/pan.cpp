@@ -147,13 +147,15 @@ ExtractedFeatures PanImpl::extract(const torch::Tensor& lr_color) {
   return {trunk_conv(trunk).add_(fea), lr_color};
 }
 
-Reconstruction PanImpl::reconstruct(const torch::Tensor& features, const torch::Tensor& skip) {
+Reconstruction PanImpl::reconstruct(const torch::Tensor& features, const torch::Tensor& skip, const HrFusion& at_hr) {
   auto fea = upconv1(graph::apply_resize(features, stage_factor_, graph::ResizeMode::Nearest));
   fea = lrelu(att1(fea));
+  if (stages_ == 1 && at_hr) fea = at_hr(fea);
   fea = lrelu(hr_conv1(fea));
   if (stages_ == 2) {
     fea = upconv2(graph::apply_resize(fea, stage_factor_, graph::ResizeMode::Nearest));
     fea = lrelu(att2(fea));
+    if (at_hr) fea = at_hr(fea);
     fea = lrelu(hr_conv2(fea));
   }
   const auto out = conv_last(fea).add_(graph::apply_resize(skip, scale_, graph::ResizeMode::Bilinear));
@@ -169,10 +171,11 @@ ExtractedPorts PanImpl::describe_extract(graph::Builder& g, int color) const {
   return {g.add(trunk, fea), color};
 }
 
-ReconstructionPorts PanImpl::describe_reconstruct(graph::Builder& g, int features, int skip) const {
+ReconstructionPorts PanImpl::describe_reconstruct(graph::Builder& g, int features, int skip,
+                                                  const HrFusionPort& at_hr) const {
   const auto stage = [&](int x, const char* up_name, const torch::nn::Conv2d& up, const char* att_name,
                          const PixelAttention& att, const char* hr_name, const torch::nn::Conv2d& hr,
-                         const std::string& up_group, const std::string& hr_group) {
+                         const std::string& up_group, const std::string& hr_group, bool last) {
     int y = g.resize(x, stage_factor_, graph::ResizeMode::Nearest);
     y = describe_conv(g, up_name, up, y, graph::group_layout(up_group, up->weight.size(0)));
     {
@@ -180,10 +183,11 @@ ReconstructionPorts PanImpl::describe_reconstruct(graph::Builder& g, int feature
       y = att->describe(g, y, up_group);
     }
     y = g.leaky_relu(y, kLeakySlope);
+    if (last && at_hr) y = at_hr(y);
     return g.leaky_relu(describe_conv(g, hr_name, hr, y, graph::group_layout(hr_group, hr->weight.size(0))), kLeakySlope);
   };
-  int fea = stage(features, "upconv1", upconv1, "att1", att1, "hr_conv1", hr_conv1, "up1", "hr1");
-  if (stages_ == 2) fea = stage(fea, "upconv2", upconv2, "att2", att2, "hr_conv2", hr_conv2, "up2", "hr2");
+  int fea = stage(features, "upconv1", upconv1, "att1", att1, "hr_conv1", hr_conv1, "up1", "hr1", stages_ == 1);
+  if (stages_ == 2) fea = stage(fea, "upconv2", upconv2, "att2", att2, "hr_conv2", hr_conv2, "up2", "hr2", true);
   const int out = describe_conv(g, "conv_last", conv_last, fea, graph::fixed_layout("rgb", 3));
   const int ilr = g.resize(skip, scale_, graph::ResizeMode::Bilinear);
   return {g.add(out, ilr), fea};

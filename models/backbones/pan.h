@@ -68,12 +68,14 @@ class PanImpl : public BackboneImpl {
  public:
   explicit PanImpl(const ArchSpec& spec);
   ExtractedFeatures extract(const torch::Tensor& lr_color) override;
-  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip) override;
+  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip, const HrFusion& at_hr) override;
   ExtractedPorts describe_extract(graph::Builder& g, int color) const override;
-  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip) const override;
+  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip,
+                                           const HrFusionPort& at_hr) const override;
   std::string feature_group() const override { return "features"; }
   int64_t feature_factor() const override { return 1; }
   std::string hr_feature_group() const override { return stages_ == 2 ? "hr2" : "hr1"; }
+  std::string hr_fusion_group() const override { return stages_ == 2 ? "up2" : "up1"; }
 
  private:
   int scale_;

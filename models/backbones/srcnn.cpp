@@ -49,7 +49,10 @@ ExtractedFeatures SrcnnImpl::extract(const torch::Tensor& lr_color) {
   return {torch::relu(conv2(x)), up};
 }
 
-Reconstruction SrcnnImpl::reconstruct(const torch::Tensor& features, const torch::Tensor& skip) {
+Reconstruction SrcnnImpl::reconstruct(const torch::Tensor& features_in, const torch::Tensor& skip,
+                                      const HrFusion& at_hr) {
+  // SRCNN's features are at HR already: the HR fusion point is the reconstruction's input.
+  const auto features = at_hr ? at_hr(features_in) : features_in;
   auto out = conv3(features);
   if (luma_) out = torch::conv2d(torch::cat({skip, out}, 1), merge_weight_, merge_bias_);
   return {out, features};
@@ -64,7 +67,9 @@ ExtractedPorts SrcnnImpl::describe_extract(graph::Builder& g, int color) const {
   return {x, up};
 }
 
-ReconstructionPorts SrcnnImpl::describe_reconstruct(graph::Builder& g, int features, int skip) const {
+ReconstructionPorts SrcnnImpl::describe_reconstruct(graph::Builder& g, int features_in, int skip,
+                                                    const HrFusionPort& at_hr) const {
+  const int features = at_hr ? at_hr(features_in) : features_in;
   int out = describe_conv(g, "conv3", conv3, features, graph::fixed_layout(luma_ ? "y" : "rgb", luma_ ? 1 : 3));
   if (luma_)
     out = g.conv("merge_y", g.concat({skip, out}), merge_weight_, merge_bias_, 0, graph::fixed_layout("rgb", 3),

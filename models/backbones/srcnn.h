@@ -22,12 +22,14 @@ class SrcnnImpl : public BackboneImpl {
  public:
   explicit SrcnnImpl(const ArchSpec& spec);
   ExtractedFeatures extract(const torch::Tensor& lr_color) override;
-  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip) override;
+  Reconstruction reconstruct(const torch::Tensor& features, const torch::Tensor& skip, const HrFusion& at_hr) override;
   ExtractedPorts describe_extract(graph::Builder& g, int color) const override;
-  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip) const override;
+  ReconstructionPorts describe_reconstruct(graph::Builder& g, int features, int skip,
+                                           const HrFusionPort& at_hr) const override;
   std::string feature_group() const override { return "conv2"; }
   int64_t feature_factor() const override { return scale_; }
   std::string hr_feature_group() const override { return "conv2"; }
+  std::string hr_fusion_group() const override { return "conv2"; }
 
  private:
   int64_t scale_;

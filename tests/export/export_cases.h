@@ -61,6 +61,11 @@ inline std::vector<ExportCase> export_cases() {
   cases.push_back({"pan_x4_rit_hr_pooled_concat_geometry",
                    with_rit(default_spec("pan", 4), "hr_pooled", "concat", /*geometry=*/true)});
   cases.push_back({"shrunk_pan_x2_rit", with_rit(shrunk_pan(2), "lr", "concat")});
+  cases.push_back({"pan_x2_rit_hr_unshuffle_concat", with_rit(default_spec("pan", 2), "hr_unshuffle", "concat")});
+  cases.push_back({"pan_x4_rit_hr_fuse_concat", with_rit(default_spec("pan", 4), "hr_fuse", "concat")});
+  cases.push_back({"edsr_x2_rit_hr_unshuffle_hr_fuse_add",
+                   with_rit(default_spec("edsr", 2), "hr_unshuffle+hr_fuse", "add")});
+  cases.push_back({"srcnn_x3_rit_hr_fuse_concat", with_rit(default_spec("srcnn", 3), "hr_fuse", "concat")});
   cases.push_back({"shrunk_edsr_x4", shrunk_edsr(4)});
   return cases;
 }

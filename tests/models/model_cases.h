@@ -50,22 +50,31 @@ inline std::pair<torch::Tensor, torch::Tensor> random_inputs(const ArchSpec& s, 
   const auto color = torch::rand({n, 3, h, w});
   torch::Tensor info;
   if (s.rit.enabled) {
-    const int64_t f = s.rit.source == "hr_pooled" ? s.scale : 1;
+    const int64_t f = s.rit.reads_hr() ? s.scale : 1;
     info = torch::rand({n, static_cast<int64_t>(s.rit.info_width()), h * f, w * f});
   }
   return {color, info};
 }
 
-// A fresh RIT fuses with a zero conv (it starts as the plain backbone); random gate and fusion
-// weights make a wrong RIT export visible in the outputs.
+// A fresh RIT fuses with zero convs (it starts as the plain backbone); random fusion weights make
+// the rendering information change the output.
+inline void randomize_fusion(SRNetworkImpl& net, double stddev = 0.05) {
+  torch::NoGradGuard no_grad;
+  for (auto* fuse : {&net.rit()->fuse, &net.rit()->hr_fuse}) {
+    if (fuse->is_empty()) continue;
+    (*fuse)->weight.normal_(0, stddev);
+    (*fuse)->bias.normal_(0, stddev / 5);
+  }
+}
+
+// Random gate and fusion weights make a wrong RIT export visible in the outputs.
 inline SRNetwork build_network(const ArchSpec& spec, uint64_t seed) {
   torch::manual_seed(seed);
   SRNetwork net(spec);
   if (net->has_rit()) {
     torch::NoGradGuard no_grad;
     net->rit()->gate.uniform_(0.5, 1.5);
-    net->rit()->fuse->weight.normal_(0, 0.05);
-    net->rit()->fuse->bias.normal_(0, 0.01);
+    randomize_fusion(*net);
   }
   net->eval();
   return net;

@@ -65,7 +65,7 @@ TEST(Backbones, FeatureMapSitsAtTheInsertionPoint) {
     const int64_t f = b.feature_factor();
     EXPECT_EQ(e.features.sizes().vec(),
               (std::vector<int64_t>{1, net->spec().group_width(b.feature_group()), 6 * f, 5 * f}));
-    const auto r = b.reconstruct(e.features, e.skip);
+    const auto r = b.reconstruct(e.features, e.skip, {});
     EXPECT_TRUE(torch::equal(r.image, net->forward(x)));
     EXPECT_EQ(r.hr_features.size(1), net->spec().group_width(b.hr_feature_group()));
     EXPECT_EQ(r.hr_features.size(2), 6 * c.scale);

@@ -21,8 +21,9 @@ Inputs inputs_of(const ArchSpec& spec, int64_t n, int64_t h, int64_t w,
                  const std::function<torch::Tensor(std::vector<int64_t>)>& make) {
   Inputs in = {{"color", make({n, 3, h, w})}};
   if (spec.rit.enabled) {
-    const int64_t f = spec.rit.source == "hr_pooled" ? spec.scale : 1;
-    in.emplace_back("info", make({n, static_cast<int64_t>(spec.rit.info_width()), h * f, w * f}));
+    const int64_t f = spec.rit.reads_hr() ? spec.scale : 1;
+    in.emplace_back(spec.rit.reads_hr() ? "info_hr" : "info",
+                    make({n, static_cast<int64_t>(spec.rit.info_width()), h * f, w * f}));
   }
   return in;
 }
@@ -138,7 +139,7 @@ TEST_F(FusedGraphTest, EveryBackboneAtEveryScale) {
 TEST_F(FusedGraphTest, RitVariants) {
   uint64_t seed = 40;
   for (const char* b : {"pan", "edsr", "srcnn"})
-    for (const char* source : {"lr", "hr_pooled"})
+    for (const auto& source : rit_sources())
       for (const char* fusion : {"concat", "add"}) {
         const int scale = fusion[0] == 'c' ? 2 : 4;
         SCOPED_TRACE(std::string(b) + " x" + std::to_string(scale) + " " + source + " " + fusion);
@@ -279,8 +280,9 @@ TEST_F(FusedGraphTest, WrongInputsAreErrors) {
   const auto info = torch::rand({1, 6, 12, 10});
   EXPECT_NO_THROW(fused.run(color, info));
   EXPECT_THROW(fused.run(color), Error);                                                       // no info
-  EXPECT_THROW(fused.run({{"colour", color}, {"info", info}}), Error);                         // unknown name
-  EXPECT_THROW(fused.run({{"color", color}, {"info", info}, {"info", info}}), Error);          // twice
+  EXPECT_THROW(fused.run({{"colour", color}, {"info_hr", info}}), Error);                      // unknown name
+  EXPECT_THROW(fused.run({{"color", color}, {"info", info}}), Error);                          // LR name
+  EXPECT_THROW(fused.run({{"color", color}, {"info_hr", info}, {"info_hr", info}}), Error);    // twice
   EXPECT_THROW(fused.run(torch::rand({1, 4, 6, 5}), info), Error);                             // channels
   EXPECT_THROW(fused.run(torch::rand({3, 6, 5}), info), Error);                                // 3-D
   EXPECT_THROW(fused.run(color, torch::rand({1, 6, 6, 5})), Error);                            // info at LR

@@ -13,16 +13,12 @@ using namespace cgsr::test;
 namespace {
 void expect_graph_matches_forward(const ArchSpec& spec) {
   SRNetwork net(spec);
-  if (net->has_rit()) {  // make the fusion non-trivial so the RIT path is exercised
-    torch::NoGradGuard no_grad;
-    net->rit()->fuse->weight.normal_(0, 0.1);
-  }
+  if (net->has_rit()) randomize_fusion(*net, 0.1);  // so the RIT path is exercised
   const auto [color, info] = random_inputs(spec, 7, 5);
   torch::NoGradGuard no_grad;
   const auto expected = net->forward_train(color, info);
-  std::vector<std::pair<std::string, torch::Tensor>> inputs = {{"color", color}};
-  if (info.defined()) inputs.emplace_back("info", info);
-  const auto outputs = graph::run(net->describe(/*training=*/true), inputs);
+  const auto g = net->describe(/*training=*/true);
+  const auto outputs = graph::run(g, network_inputs(g, color, info));
   ASSERT_GE(outputs.size(), 1u);
   EXPECT_EQ(outputs[0].first, "image");
   EXPECT_TRUE(torch::equal(outputs[0].second, expected.image));
@@ -44,7 +40,7 @@ TEST(Graph, InterpreterReproducesEveryBackbone) {
 TEST(Graph, InterpreterReproducesRitVariants) {
   torch::manual_seed(2);
   for (const char* b : {"srcnn", "edsr", "pan"})
-    for (const char* source : {"lr", "hr_pooled"})
+    for (const auto& source : rit_sources())
       for (const char* fusion : {"concat", "add"}) {
         SCOPED_TRACE(std::string(b) + " " + source + " " + fusion);
         expect_graph_matches_forward(with_rit(default_spec(b, 3), source, fusion, /*geometry=*/true));

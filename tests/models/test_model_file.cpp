@@ -142,3 +142,52 @@ TEST(ModelFile, ExpectedRenderingChannelsAreRecorded) {
             (std::vector<RenderChannel>{RenderChannel::Depth, RenderChannel::Normal}));
   fs::remove_all(dir);
 }
+
+namespace {
+// The file a cgsr from before `rit.depth_encoding` wrote: the same bytes with that spec line
+// removed, lengths and checksum redone (model_file.h layout).
+void drop_depth_encoding(const fs::path& path) {
+  const std::string bytes = read_file(path);
+  const auto u64 = [&](size_t at) {
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  const uint64_t meta_size = u64(12), weight_size = u64(20);
+  auto meta = nlohmann::ordered_json::parse(bytes.substr(28, meta_size));
+  std::string spec = meta["spec"];
+  const auto line = spec.find("  depth_encoding: log\n");
+  ASSERT_NE(line, std::string::npos) << spec;
+  spec.erase(line, std::string("  depth_encoding: log\n").size());
+  meta["spec"] = spec;
+  const std::string new_meta = meta.dump();
+  std::string out = bytes.substr(0, 12);
+  const auto put = [&](uint64_t v) {
+    for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  };
+  put(new_meta.size());
+  put(weight_size);
+  out += new_meta + bytes.substr(28 + meta_size, weight_size);
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : out) h = (h ^ c) * 1099511628211ULL;
+  put(h);
+  write_file_atomic(path, out);
+}
+}  // namespace
+
+TEST(ModelFile, FilesFromBeforeDepthEncodingsReadZBufferDepth) {
+  const auto dir = scratch_dir("model-file-legacy");
+  SRNetwork net = build_network(with_rit(default_spec("pan", 2)), 11);
+  EXPECT_EQ(net->spec().rit.depth_encoding, "log");  // what new networks read
+  save_model(dir / "old.cgsr", *net);
+  drop_depth_encoding(dir / "old.cgsr");
+  Model old = load_model(dir / "old.cgsr");
+  EXPECT_EQ(old.network->spec().rit.depth_encoding, "zbuffer");
+  EXPECT_EQ(old.network->depth_encoding(), DepthEncoding::ZBuffer);
+  // Same weights, same function: only the input contract differs.
+  const auto [color, info] = random_inputs(net->spec(), 6, 5);
+  torch::NoGradGuard no_grad;
+  old.network->eval();
+  EXPECT_TRUE(torch::equal(old.network->forward(color, info), net->forward(color, info)));
+  fs::remove_all(dir);
+}

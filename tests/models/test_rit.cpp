@@ -14,7 +14,7 @@ TEST(Rit, EnhancedNetworkEqualsItsBackboneAtInitialization) {
   torch::manual_seed(3);
   for (const auto& c : all_backbone_cases()) {
     SRNetwork backbone(spec_for(c));
-    for (const char* source : {"lr", "hr_pooled"})
+    for (const auto& source : rit_sources())
       for (const char* fusion : {"concat", "add"}) {
         SCOPED_TRACE(case_name(c) + " " + source + " " + fusion);
         const ArchSpec cg = with_rit(spec_for(c), source, fusion, /*geometry=*/true);
@@ -93,11 +93,16 @@ TEST(Rit, ImportanceIsTheL1NormOfProducingWeights) {
 
 TEST(Rit, WrongInfoShapesAreClearErrors) {
   SRNetwork lr(with_rit(default_spec("pan", 2)));
-  SRNetwork hr(with_rit(default_spec("pan", 2), "hr_pooled"));
   const auto color = torch::rand({1, 3, 4, 4});
   EXPECT_THROW(lr->forward(color), Error);
   EXPECT_THROW(lr->forward(color, torch::rand({1, 6, 8, 8})), Error);
-  EXPECT_NO_THROW(hr->forward(color, torch::rand({1, 6, 8, 8})));
+  for (const auto& source : rit_sources()) {
+    if (source == "lr") continue;
+    SRNetwork hr(with_rit(default_spec("pan", 2), source));
+    EXPECT_NO_THROW(hr->forward(color, torch::rand({1, 6, 8, 8}))) << source;
+    EXPECT_THROW(hr->forward(color, torch::rand({1, 6, 4, 4})), Error) << source;
+    EXPECT_TRUE(hr->describe().has_input("info_hr")) << source;
+  }
   try {
     lr->forward(color, torch::rand({1, 5, 4, 4}));
     FAIL();
@@ -132,4 +137,85 @@ TEST(Rit, NetworkTakesItsChannelsFromABatch) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("'edge'"), std::string::npos) << e.what();
   }
+}
+
+TEST(Rit, HrUnshuffleIsSpaceToDepthThenConv3x3OnTheLrGrid) {
+  // The strided conv of hr_unshuffle must equal the paper-style formulation: pixel_unshuffle of
+  // the HR map (LR pixel (i, j) <- HR pixels s*i.. s*i+s-1, s*j.. s*j+s-1), then a 3x3 conv.
+  torch::manual_seed(21);
+  for (int s : {2, 3, 4}) {
+    SCOPED_TRACE(s);
+    SRNetwork net(with_rit(default_spec("pan", s), "hr_unshuffle"));
+    auto conv = net->rit()->conv;
+    const int64_t c = 6, w = conv->weight.size(0);
+    ASSERT_EQ(conv->weight.sizes().vec(), (std::vector<int64_t>{w, c, 3 * s, 3 * s}));
+    // [w, c, 3 (ky), s (a), 3 (kx), s (b)] -> [w, c, a, b, ky, kx] -> [w, c*s*s, 3, 3]
+    const auto unshuffled_weight = conv->weight.view({w, c, 3, s, 3, s}).permute({0, 1, 3, 5, 2, 4}).reshape({w, c * s * s, 3, 3});
+    const auto info = torch::rand({1, c, 5 * s, 7 * s});
+    torch::NoGradGuard no_grad;
+    const auto strided = conv(info);
+    const auto reference = torch::conv2d(torch::pixel_unshuffle(info, s), unshuffled_weight, conv->bias, 1, 1);
+    ASSERT_EQ(strided.sizes().vec(), (std::vector<int64_t>{1, w, 5, 7}));
+    EXPECT_TRUE(torch::allclose(strided, reference, 1e-5, 1e-5));
+    // Moving the HR map by one LR pixel moves the features by one LR pixel; by one HR pixel it does not.
+    const auto by_lr_pixel = conv(torch::roll(info, {s}, {3}));
+    EXPECT_TRUE(torch::allclose(by_lr_pixel.slice(3, 2, 6), strided.slice(3, 1, 5), 1e-5, 1e-5));
+    const auto by_hr_pixel = conv(torch::roll(info, {1}, {3}));
+    EXPECT_FALSE(torch::allclose(by_hr_pixel.slice(3, 2, 6), strided.slice(3, 1, 5), 1e-3, 1e-3));
+  }
+}
+
+TEST(Rit, HrFusionReadsGeometryAtTheOutputPixel) {
+  // With hr_conv reduced to its centre tap, an edge at one HR pixel reaches exactly as far as the
+  // backbone's convolutions after the fusion point, the same distance on every side: a branch
+  // off by one pixel (or fused before the last upsampling) would not be symmetric or would reach
+  // further.
+  torch::manual_seed(22);
+  const std::vector<std::pair<const char*, int64_t>> reach = {{"pan", 2}, {"edsr", 1}, {"srcnn", 2}};
+  for (const auto& [backbone, r] : reach)
+    for (int s : {2, 3, 4}) {
+      SCOPED_TRACE(std::string(backbone) + " x" + std::to_string(s));
+      SRNetwork net(with_rit(default_spec(backbone, s), "hr_fuse"));
+      randomize_fusion(*net, 0.2);
+      net->eval();
+      torch::NoGradGuard no_grad;
+      auto& w = net->rit()->hr_conv->weight;
+      const auto centre = w.slice(2, 1, 2).slice(3, 1, 2).clone();
+      w.zero_();
+      w.slice(2, 1, 2).slice(3, 1, 2).copy_(centre);
+      const int64_t h = 5, wd = 5, y = 2 * s + 1, x = 2 * s;
+      const auto color = torch::rand({1, 3, h, wd});
+      auto info = torch::zeros({1, 6, h * s, wd * s});
+      const auto base = net->forward(color, info);
+      info[0][5][y][x] = 1;  // the edge channel
+      const auto diff = (net->forward(color, info) - base).abs().sum(0).sum(0);
+      for (const auto& [dy, dx] : std::vector<std::pair<int64_t, int64_t>>{{0, 0}, {-r, 0}, {r, 0}, {0, -r}, {0, r}})
+        EXPECT_GT(diff[y + dy][x + dx].item<float>(), 0.f) << dy << "," << dx;
+      auto outside = diff.clone();
+      outside.slice(0, y - r, y + r + 1).slice(1, x - r, x + r + 1).zero_();
+      EXPECT_EQ(outside.max().item<float>(), 0.f);
+    }
+}
+
+TEST(Rit, BatchesInAnotherDepthEncodingAreRefused) {
+  SRNetwork net(with_rit(default_spec("pan", 2)));
+  Batch batch;
+  batch.scale = 2;
+  batch.channels = {RenderChannel::Depth, RenderChannel::Normal, RenderChannel::NormalAngle, RenderChannel::Edge};
+  batch.lr_info = torch::rand({1, 6, 3, 3});
+  batch.hr_info = torch::rand({1, 6, 6, 6});
+  batch.depth_encoding = DepthEncoding::Log;
+  EXPECT_NO_THROW(net->info_input(batch));
+  batch.depth_encoding = DepthEncoding::ZBuffer;
+  try {
+    net->info_input(batch);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("zbuffer-encoded, the model reads log"), std::string::npos) << e.what();
+  }
+  // Without depth among the channels the encoding does not matter.
+  ArchSpec no_depth = with_rit(default_spec("pan", 2));
+  no_depth.rit.channels = {"edge"};
+  SRNetwork edges(resolve_spec(no_depth));
+  EXPECT_NO_THROW(edges->info_input(batch));
 }

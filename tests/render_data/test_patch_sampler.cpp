@@ -138,7 +138,7 @@ TEST(FrameIterator, IteratesWholeFramesOfASplit) {
   EXPECT_EQ(b.lr_color.sizes(), (std::vector<int64_t>{1, 3, 30, 40}));
   EXPECT_EQ(b.hr_info.sizes(), (std::vector<int64_t>{1, 2, 60, 80}));
   EXPECT_EQ(b.frames, std::vector<int>{it.frame_index(0)});
-  const Batch same = frame_batch(data, it.frame_index(0), 2, {RenderChannel::Depth, RenderChannel::Edge});
+  const Batch same = frame_batch(data, it.frame_index(0), 2, {RenderChannel::Depth, RenderChannel::Edge}, DepthEncoding::Log);
   EXPECT_TRUE(torch::equal(same.hr_info, b.hr_info));
   FrameIterator all(data, {2, Split::All, {}});
   EXPECT_EQ(all.size(), 10);
