@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "cli/command.h"
+#include "cli/commands/ablate.h"
 #include "cli/commands/bench.h"
 #include "cli/commands/data_check.h"
 #include "cli/commands/info.h"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   setup_prune(app);
   setup_report(app);
   setup_export(app);
+  setup_ablate(app);
   setup_run(app);
 
   try {

@@ -20,6 +20,12 @@ std::string tick_text(double v) {
   return s.str();
 }
 
+void write_png(const std::filesystem::path& path, const cv::Mat& img) {
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", img, png)) throw Error(path.string(), "cannot encode the plot");
+  write_file_atomic(path, std::string(png.begin(), png.end()));
+}
+
 // "Nice" tick values covering [lo, hi].
 std::vector<double> ticks(double lo, double hi, bool log_scale) {
   std::vector<double> out;
@@ -117,9 +123,70 @@ void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& pl
   }
   for (const auto& note : plot.notes) legend(note, black);
 
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", img, png)) throw Error(path.string(), "cannot encode the plot");
-  write_file_atomic(path, std::string(png.begin(), png.end()));
+  write_png(path, img);
+}
+
+void write_bar_chart(const std::filesystem::path& path, const BarChart& chart) {
+  std::vector<double> ys = {0.0};
+  for (const auto& s : chart.series) {
+    if (s.values.size() != chart.categories.size())
+      throw Error(path.string(), "bar series '" + s.name + "' has " + std::to_string(s.values.size()) +
+                                     " values for " + std::to_string(chart.categories.size()) + " categories");
+    for (const auto* v : {&s.values, &s.low, &s.high})
+      for (double y : *v)
+        if (std::isfinite(y)) ys.push_back(y);
+  }
+  if (chart.categories.empty() || chart.series.empty()) throw Error(path.string(), "nothing to plot");
+  const double lo = *std::min_element(ys.begin(), ys.end()), hi = *std::max_element(ys.begin(), ys.end());
+  const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5, y_lo = lo - margin, y_hi = hi + margin;
+
+  const int group = std::max(60, 22 * static_cast<int>(chart.series.size()) + 24);
+  const int left = 80, right = 220, top = 50, bottom = 150;
+  const int width = left + right + group * static_cast<int>(chart.categories.size()), height = 560;
+  auto py = [&](double y) { return static_cast<int>(height - bottom - (y - y_lo) / (y_hi - y_lo) * (height - top - bottom)); };
+
+  cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Scalar black(0, 0, 0), grey(215, 215, 215);
+  for (double v : ticks(y_lo, y_hi, false)) {
+    cv::line(img, {left, py(v)}, {width - right, py(v)}, grey, 1);
+    cv::putText(img, tick_text(v), {8, py(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
+  }
+  cv::line(img, {left, py(0)}, {width - right, py(0)}, black, 1);
+  cv::rectangle(img, {left, top}, {width - right, height - bottom}, black, 1);
+  cv::putText(img, chart.y_label, {8, top - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.55, black);
+  cv::putText(img, chart.title, {left + 20, 28}, cv::FONT_HERSHEY_SIMPLEX, 0.7, black, 2);
+
+  const int bar = (group - 24) / static_cast<int>(chart.series.size());
+  for (size_t c = 0; c < chart.categories.size(); ++c) {
+    const int x0 = left + static_cast<int>(c) * group + 12;
+    for (size_t k = 0; k < chart.series.size(); ++k) {
+      const auto& s = chart.series[k];
+      const double v = s.values[c];
+      if (!std::isfinite(v)) continue;
+      const int xa = x0 + static_cast<int>(k) * bar, xb = xa + bar - 2;
+      cv::rectangle(img, {xa, std::min(py(0), py(v))}, {xb, std::max(py(0), py(v))}, bgr(s.colour), cv::FILLED);
+      if (c < s.low.size() && c < s.high.size() && std::isfinite(s.low[c]) && std::isfinite(s.high[c])) {
+        const int xm = (xa + xb) / 2;
+        cv::line(img, {xm, py(s.low[c])}, {xm, py(s.high[c])}, black, 1);
+        cv::line(img, {xm - 3, py(s.low[c])}, {xm + 3, py(s.low[c])}, black, 1);
+        cv::line(img, {xm - 3, py(s.high[c])}, {xm + 3, py(s.high[c])}, black, 1);
+      }
+    }
+    // Category names run downwards at 90 degrees: drawn on a strip, then rotated.
+    const std::string& name = chart.categories[c];
+    cv::Mat strip(group - 8, bottom - 10, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::putText(strip, name, {4, (group - 8) / 2 + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
+    cv::Mat turned;
+    cv::rotate(strip, turned, cv::ROTATE_90_CLOCKWISE);
+    turned.copyTo(img(cv::Rect(x0 - 8, height - bottom + 6, turned.cols, turned.rows)));
+  }
+  int legend_y = top + 10;
+  for (const auto& s : chart.series) {
+    cv::rectangle(img, {width - right + 12, legend_y - 10}, {width - right + 24, legend_y}, bgr(s.colour), cv::FILLED);
+    cv::putText(img, s.name, {width - right + 30, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
+    legend_y += 18;
+  }
+  write_png(path, img);
 }
 
 }  // namespace cgsr

@@ -1,5 +1,6 @@
 #pragma once
-// Scatter plots as PNG (OpenCV drawing): quality against cost for reports and search histories.
+// Plots as PNG (OpenCV drawing): scatter plots of quality against cost for reports and search
+// histories, grouped bar charts with error bars for ablations.
 
 #include <array>
 #include <filesystem>
@@ -33,5 +34,21 @@ struct ScatterPlot {
 
 // Throws cgsr::Error naming the path when there is nothing to draw.
 void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot);
+
+struct BarSeries {
+  std::string name;  // legend entry
+  Rgb colour{40, 90, 180};
+  std::vector<double> values;     // one per category
+  std::vector<double> low, high;  // error bar ends per category (empty: none)
+};
+
+// Groups of bars, one group per category, one bar per series; the zero line is drawn.
+struct BarChart {
+  std::string title, y_label;
+  std::vector<std::string> categories;  // written under their group, turned when long
+  std::vector<BarSeries> series;
+};
+
+void write_bar_chart(const std::filesystem::path& path, const BarChart& chart);
 
 }  // namespace cgsr
