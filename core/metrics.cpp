@@ -125,6 +125,41 @@ double sum_squared_error(const T* a, const T* b, int64_t count) {
       },
       std::plus<double>());
 }
+
+struct SplitError {
+  double inside = 0, outside = 0;
+};
+
+// Squared error of one image (c planes of h x w) split by a h x w mask, parallel over rows.
+template <class T>
+SplitError masked_squared_error(const T* a, const T* b, const uint8_t* mask, int64_t c, int64_t h, int64_t w) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, h), SplitError{},
+      [&](const tbb::blocked_range<int64_t>& rows, SplitError sum) {
+        for (int64_t y = rows.begin(); y < rows.end(); ++y) {
+          const uint8_t* m = mask + y * w;
+          for (int64_t ch = 0; ch < c; ++ch) {
+            const T* ra = a + (ch * h + y) * w;
+            const T* rb = b + (ch * h + y) * w;
+            for (int64_t x = 0; x < w; ++x) {
+              const double d = static_cast<double>(ra[x]) - static_cast<double>(rb[x]);
+              (m[x] ? sum.inside : sum.outside) += d * d;
+            }
+          }
+        }
+        return sum;
+      },
+      [](SplitError l, const SplitError& r) {
+        l.inside += r.inside;
+        l.outside += r.outside;
+        return l;
+      });
+}
+
+std::optional<double> psnr_of(double sse, int64_t count) {
+  if (count == 0) return std::nullopt;
+  return -10.0 * std::log10(sse / static_cast<double>(count));  // mse = 0 gives +inf
+}
 }  // namespace
 
 torch::Tensor psnr(const torch::Tensor& output, const torch::Tensor& reference, const QualityOptions& options) {
@@ -157,6 +192,34 @@ torch::Tensor ssim(const torch::Tensor& output, const torch::Tensor& reference, 
     }
     if (!std::isfinite(sum)) non_finite("SSIM");
     out[i] = sum / static_cast<double>(c);
+  }
+  return out;
+}
+
+std::vector<MaskedPsnr> masked_psnr(const torch::Tensor& output, const torch::Tensor& reference,
+                                    const torch::Tensor& mask, const QualityOptions& options) {
+  const auto [a, b] = prepare(output, reference, options, "masked PSNR");
+  auto m = mask.dim() == 3 && mask.size(0) == 1 ? mask.squeeze(0) : mask;
+  if (m.dim() != 2 || m.size(0) != output.size(-2) || m.size(1) != output.size(-1))
+    throw Error("masked PSNR", "the mask must be [H,W] or [1,H,W] at the images' size " + shape_string(output) +
+                                   ", got " + shape_string(mask));
+  if (m.scalar_type() != torch::kBool && m.scalar_type() != torch::kUInt8)
+    throw Error("masked PSNR", std::string("the mask must be bool or uint8, got ") + c10::toString(m.scalar_type()));
+  const int64_t crop = options.crop_border;  // prepare() checked it against the size
+  m = (m.slice(0, crop, m.size(0) - crop).slice(1, crop, m.size(1) - crop) != 0).to(torch::kUInt8).contiguous();
+  const int64_t n = a.size(0), c = a.size(1), h = a.size(2), w = a.size(3);
+  const int64_t inside = m.sum().item<int64_t>(), outside = h * w - inside;
+  std::vector<MaskedPsnr> out(n);
+  for (int64_t i = 0; i < n; ++i) {
+    const int64_t offset = i * c * h * w;
+    const SplitError e =
+        a.scalar_type() == torch::kFloat64
+            ? masked_squared_error(a.data_ptr<double>() + offset, b.data_ptr<double>() + offset, m.data_ptr<uint8_t>(), c, h, w)
+            : masked_squared_error(a.data_ptr<float>() + offset, b.data_ptr<float>() + offset, m.data_ptr<uint8_t>(), c, h, w);
+    if (!std::isfinite(e.inside) || !std::isfinite(e.outside)) non_finite("masked PSNR");
+    out[i].inside = psnr_of(e.inside, inside * c);
+    out[i].outside = psnr_of(e.outside, outside * c);
+    out[i].inside_fraction = static_cast<double>(inside) / static_cast<double>(h * w);
   }
   return out;
 }

@@ -2,6 +2,7 @@
 
 #include <oneapi/tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -88,6 +89,25 @@ torch::Tensor detect_edges(const torch::Tensor& depth, const torch::Tensor& norm
     }
   });
   return out;
+}
+
+torch::Tensor dilate_edges(const torch::Tensor& edges) {
+  CGSR_CHECK(edges.dim() == 2 || (edges.dim() == 3 && edges.size(0) == 1), "dilate_edges needs an [H,W] edge map");
+  const int64_t H = edges.size(-2), W = edges.size(-1);
+  const auto in = (edges.reshape({H, W}) != 0).to(torch::kUInt8).contiguous();
+  auto out = torch::empty({H, W}, torch::kBool);
+  const uint8_t* e = in.data_ptr<uint8_t>();
+  bool* o = out.data_ptr<bool>();
+  tbb::parallel_for(int64_t{0}, H, [&](int64_t y) {
+    const uint8_t* rows[3] = {e + std::max<int64_t>(y - 1, 0) * W, e + y * W, e + std::min(y + 1, H - 1) * W};
+    for (int64_t x = 0; x < W; ++x) {
+      const int64_t l = std::max<int64_t>(x - 1, 0), r = std::min(x + 1, W - 1);
+      bool any = false;
+      for (const uint8_t* row : rows) any = any || row[l] || row[x] || row[r];
+      o[y * W + x] = any;
+    }
+  });
+  return out.view(edges.sizes());
 }
 
 }  // namespace cgsr

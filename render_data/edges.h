@@ -1,6 +1,7 @@
 #pragma once
 // Object edges from a G-buffer: used by the renderer (depth + normals + ids) and by loaders
-// that derive a missing edge channel from depth alone.
+// that derive a missing edge channel from depth alone; and the widened edge region on which
+// evaluation measures quality.
 //
 // A pair of 4-neighbour pixels (p, q) is a discontinuity when any of these holds:
 //   depth   1/z is affine in pixel coordinates on any plane, so each side's linear extrapolation
@@ -27,5 +28,10 @@ struct EdgeSettings {
 // Returns float32 [1,H,W] with values 0 and 1.
 torch::Tensor detect_edges(const torch::Tensor& depth, const torch::Tensor& normal, const torch::Tensor& ids,
                            const EdgeSettings& settings);
+
+// The edge map grown by one pixel in every direction (3x3 maximum, the window clamped at the
+// borders): the one-pixel-wide silhouettes plus the pixels an upscaler blends across them.
+// edges: [H,W] or [1,H,W], any type, nonzero = edge. Returns bool of the same shape.
+torch::Tensor dilate_edges(const torch::Tensor& edges);
 
 }  // namespace cgsr

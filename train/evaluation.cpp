@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/progress.h"
+#include "render_data/edges.h"
 #include "render_data/patch_sampler.h"
 #include "train/temporal.h"
 
@@ -88,6 +89,37 @@ torch::Tensor hr_motion(const Batch& b) {
   throw Error("evaluation", "the batch has no motion vectors", ErrorKind::Internal);
 }
 
+// The HR edge map of `frame` at the size of `hr_color` (the batch's HR frame, from the cache),
+// or undefined when the dataset does not carry edges at that resolution.
+torch::Tensor hr_edges(const Dataset& data, int frame, const torch::Tensor& hr_color) {
+  const size_t resolution =
+      data.resolution_index({static_cast<int>(hr_color.size(-1)), static_cast<int>(hr_color.size(-2))});
+  const auto& here = channels_at(data.info(), resolution);
+  if (std::find(here.begin(), here.end(), RenderChannel::Edge) == here.end()) return {};
+  return data.frame(frame, resolution)->edge;
+}
+
+// Mean of a per-frame PSNR over the frames that have one, infinite ones (no error) left out as
+// in the overall PSNR; +inf when every one is infinite.
+std::optional<double> mean_psnr(const std::vector<FrameScore>& frames, std::optional<double> FrameScore::*field) {
+  double sum = 0;
+  int finite = 0, present = 0;
+  for (const auto& f : frames)
+    if (f.*field) {
+      ++present;
+      if (!std::isinf(*(f.*field))) {
+        sum += *(f.*field);
+        ++finite;
+      }
+    }
+  if (!present) return std::nullopt;
+  return finite ? sum / finite : INFINITY;
+}
+
+std::string psnr_text(std::optional<double> value) {
+  return value ? fmt::format("{:.3f} dB", *value) : std::string("n/a");
+}
+
 std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::optional<double> FrameScore::*field) {
   double sum = 0;
   int n = 0;
@@ -133,6 +165,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   int last_frame = -1;
   Batch last_batch;
   torch::Tensor last_sr;
+  bool warned_no_edges = false;
   for (int frame : frames) {
     const Batch b = frame_batch(data, frame, result.scale, channels, depth);
     const auto sr = upscale_frame(b, frame).clamp(0.0, 1.0);
@@ -151,6 +184,16 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
       ++psnr_count;
     }
     ssim_sum += score.ssim;
+    if (const auto edges = hr_edges(data, frame, b.hr_color); edges.defined()) {
+      const MaskedPsnr split = masked_psnr(sr, b.hr_color, dilate_edges(edges), quality).at(0);
+      score.psnr_edge = split.inside;
+      score.psnr_rest = split.outside;
+      score.edge_fraction = split.inside_fraction;
+    } else if (!warned_no_edges) {
+      spdlog::warn("{}: no edge channel at {}x{}: PSNR on edges and on the rest skipped", data.info().root.string(),
+                   b.hr_color.size(-1), b.hr_color.size(-2));
+      warned_no_edges = true;
+    }
     if (temporal && frame > 0) {
       const bool consecutive = last_frame == frame - 1;
       const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels, depth);
@@ -173,10 +216,16 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   progress.finish();
   result.psnr = psnr_count ? psnr_sum / psnr_count : INFINITY;
   result.ssim = ssim_sum / static_cast<double>(frames.size());
+  result.psnr_edge = mean_psnr(result.frames, &FrameScore::psnr_edge);
+  result.psnr_rest = mean_psnr(result.frames, &FrameScore::psnr_rest);
+  result.edge_fraction = mean_of(result.frames, &FrameScore::edge_fraction);
   result.temporal_error = mean_of(result.frames, &FrameScore::temporal_error);
   result.temporal_error_reference = mean_of(result.frames, &FrameScore::temporal_error_reference);
   // Quality is known before latency, which can take minutes at large sizes.
   spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f} on {} frame(s)", result.name, result.psnr, result.ssim, frames.size());
+  if (result.edge_fraction)
+    spdlog::info("{}: PSNR on geometry edges {} ({:.1f}% of pixels), on the rest {}", result.name,
+                 psnr_text(result.psnr_edge), 100.0 * *result.edge_fraction, psnr_text(result.psnr_rest));
 
   const Batch first = frame_batch(data, frames.front(), result.scale, upscaler.channels(), upscaler.depth_encoding());
   result.lr_width = first.lr_color.size(3);
@@ -196,6 +245,44 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   return result;
 }
 
+namespace {
+// Optional PSNRs: absent is null, infinite is null with "<key>_infinite": true (put_psnr).
+void put_optional_psnr(nlohmann::ordered_json& j, const std::string& key, std::optional<double> value) {
+  if (value)
+    put_psnr(j, key, *value);
+  else
+    j[key] = nullptr;
+}
+
+std::optional<double> optional_psnr(const nlohmann::ordered_json& j, const std::string& key) {
+  if (!j.contains(key)) return std::nullopt;  // written before edge PSNR existed
+  if (!j.at(key).is_null()) return j.at(key).get<double>();
+  if (j.value(key + "_infinite", false)) return INFINITY;
+  return std::nullopt;
+}
+
+nlohmann::ordered_json optional_value(std::optional<double> value) {
+  return value ? nlohmann::ordered_json(*value) : nullptr;
+}
+
+std::optional<double> optional_number(const nlohmann::ordered_json& j, const std::string& key) {
+  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
+  return j.at(key).get<double>();
+}
+
+void put_edge_scores(nlohmann::ordered_json& j, std::optional<double> psnr_edge, std::optional<double> psnr_rest,
+                     std::optional<double> edge_fraction) {
+  put_optional_psnr(j, "psnr_edge", psnr_edge);
+  put_optional_psnr(j, "psnr_rest", psnr_rest);
+  j["edge_fraction"] = optional_value(edge_fraction);
+}
+
+std::string csv_psnr(std::optional<double> value) {
+  if (!value) return "";
+  return std::isinf(*value) ? std::string("inf") : std::to_string(*value);
+}
+}  // namespace
+
 nlohmann::ordered_json to_json(const EvalResult& r) {
   nlohmann::ordered_json j;
   j["name"] = r.name;
@@ -207,6 +294,7 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
   put_psnr(j, "psnr", r.psnr);
   j["ssim"] = r.ssim;
   j["identical_frames"] = r.identical_frames;
+  put_edge_scores(j, r.psnr_edge, r.psnr_rest, r.edge_fraction);
   j["temporal_error"] = r.temporal_error ? nlohmann::ordered_json(*r.temporal_error) : nullptr;
   j["temporal_error_reference"] =
       r.temporal_error_reference ? nlohmann::ordered_json(*r.temporal_error_reference) : nullptr;
@@ -234,6 +322,7 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
     fj["frame"] = f.frame;
     put_psnr(fj, "psnr", f.psnr);
     fj["ssim"] = f.ssim;
+    put_edge_scores(fj, f.psnr_edge, f.psnr_rest, f.edge_fraction);
     fj["temporal_error"] = f.temporal_error ? nlohmann::ordered_json(*f.temporal_error) : nullptr;
     fj["temporal_error_reference"] =
         f.temporal_error_reference ? nlohmann::ordered_json(*f.temporal_error_reference) : nullptr;
@@ -255,6 +344,9 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
     r.psnr = j.at("psnr").is_null() ? INFINITY : j.at("psnr").get<double>();
     r.ssim = j.at("ssim");
     r.identical_frames = j.value("identical_frames", 0);
+    r.psnr_edge = optional_psnr(j, "psnr_edge");
+    r.psnr_rest = optional_psnr(j, "psnr_rest");
+    r.edge_fraction = optional_number(j, "edge_fraction");
     if (!j.at("temporal_error").is_null()) r.temporal_error = j.at("temporal_error").get<double>();
     if (!j.at("temporal_error_reference").is_null())
       r.temporal_error_reference = j.at("temporal_error_reference").get<double>();
@@ -281,6 +373,9 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
       s.frame = f.at("frame");
       s.psnr = f.at("psnr").is_null() ? INFINITY : f.at("psnr").get<double>();
       s.ssim = f.at("ssim");
+      s.psnr_edge = optional_psnr(f, "psnr_edge");
+      s.psnr_rest = optional_psnr(f, "psnr_rest");
+      s.edge_fraction = optional_number(f, "edge_fraction");
       if (!f.at("temporal_error").is_null()) s.temporal_error = f.at("temporal_error").get<double>();
       if (!f.at("temporal_error_reference").is_null())
         s.temporal_error_reference = f.at("temporal_error_reference").get<double>();
@@ -295,11 +390,13 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
 
 std::string frames_csv(const EvalResult& r) {
   std::ostringstream csv;
-  csv << "model,frame,psnr,ssim,temporal_error,temporal_error_reference\n";
+  csv << "model,frame,psnr,ssim,temporal_error,temporal_error_reference,psnr_edge,psnr_rest,edge_fraction\n";
   for (const auto& f : r.frames) {
     csv << r.name << "," << f.frame << "," << (std::isinf(f.psnr) ? std::string("inf") : std::to_string(f.psnr)) << ","
         << f.ssim << "," << (f.temporal_error ? std::to_string(*f.temporal_error) : "") << ","
-        << (f.temporal_error_reference ? std::to_string(*f.temporal_error_reference) : "") << "\n";
+        << (f.temporal_error_reference ? std::to_string(*f.temporal_error_reference) : "") << ","
+        << csv_psnr(f.psnr_edge) << "," << csv_psnr(f.psnr_rest) << ","
+        << (f.edge_fraction ? std::to_string(*f.edge_fraction) : "") << "\n";
   }
   return csv.str();
 }

@@ -1,7 +1,9 @@
 #pragma once
 // Evaluation of any upscaler on full frames of a data set split: per-frame PSNR/SSIM (README
-// convention), temporal stability (warping error between consecutive outputs using the rendered
-// motion vectors, next to the same figure for the ground truth), and latency at the frame size.
+// convention), PSNR on geometry edges and on the rest of the frame (the HR edge channel grown by
+// one pixel, edges.h; needs the dataset to carry edges at HR, whatever the upscaler reads),
+// temporal stability (warping error between consecutive outputs using the rendered motion
+// vectors, next to the same figure for the ground truth), and latency at the frame size.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -36,6 +38,9 @@ std::vector<int> evaluation_frames(const Dataset& data, const EvalOptions& optio
 struct FrameScore {
   int frame = 0;
   double psnr = 0, ssim = 0;
+  // PSNR on the dilated HR edge pixels and on the others, and the edge pixels' share of the
+  // compared pixels; none without an edge channel (or, for one side, without pixels there).
+  std::optional<double> psnr_edge, psnr_rest, edge_fraction;
   std::optional<double> temporal_error, temporal_error_reference;  // none for the first frame
   nlohmann::ordered_json details;  // Upscaler::frame_details() of this frame (null for most upscalers)
 };
@@ -49,6 +54,9 @@ struct EvalResult {
   std::vector<FrameScore> frames;
   double psnr = 0, ssim = 0;  // means over frames (PSNR of identical frames excluded, counted)
   int identical_frames = 0;
+  // Means over the frames that have them (infinite values excluded like psnr's; +inf when
+  // every one is infinite).
+  std::optional<double> psnr_edge, psnr_rest, edge_fraction;
   std::optional<double> temporal_error, temporal_error_reference;
   std::optional<LatencyStats> latency;
   // The exported ONNX file of the network in ONNX Runtime on the same input (what a game would

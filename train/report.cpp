@@ -20,8 +20,12 @@ std::string fixed(double v, int digits) {
 }
 
 struct Cells {
-  std::string params, macs, latency, ort_latency, psnr, ssim, temporal;
+  std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
 };
+
+std::string optional_fixed(std::optional<double> v, int digits, const std::string& none) {
+  return v ? fixed(*v, digits) : none;
+}
 
 Cells cells(const EvalResult& r) {
   Cells c;
@@ -30,6 +34,8 @@ Cells cells(const EvalResult& r) {
   c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
   c.ort_latency = r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 2) : "-";
   c.psnr = fixed(r.psnr, 2);
+  c.psnr_edge = optional_fixed(r.psnr_edge, 2, "-");
+  c.psnr_rest = optional_fixed(r.psnr_rest, 2, "-");
   c.ssim = fixed(r.ssim, 4);
   c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
   return c;
@@ -75,16 +81,21 @@ std::string report_markdown(const ReportTable& table) {
      << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
   const bool ort = std::any_of(table.rows.begin(), table.rows.end(),
                                [](const EvalResult& r) { return r.onnxruntime_latency.has_value(); });
-  md << "| Model | Params (k) | MACs (G) | Latency (ms) |" << (ort ? " ONNX Runtime (ms) |" : "")
-     << " PSNR (dB) | SSIM | Temporal error (x1e-3) |\n";
-  md << "|---|---:|---:|---:|" << (ort ? "---:|" : "") << "---:|---:|---:|\n";
+  // Edge and rest PSNR need the dataset's edge channel; rows from older results lack them.
+  const auto with_edges = std::find_if(table.rows.begin(), table.rows.end(),
+                                       [](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
+  const bool edges = with_edges != table.rows.end();
+  md << "| Model | Params (k) | MACs (G) | Latency (ms) |" << (ort ? " ONNX Runtime (ms) |" : "") << " PSNR (dB) |"
+     << (edges ? " Edge PSNR (dB) | Rest PSNR (dB) |" : "") << " SSIM | Temporal error (x1e-3) |\n";
+  md << "|---|---:|---:|---:|" << (ort ? "---:|" : "") << "---:|" << (edges ? "---:|---:|" : "") << "---:|---:|\n";
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
     const auto c = cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | " << c.latency
-       << " | " << (ort ? c.ort_latency + " | " : "") << c.psnr << " | " << c.ssim << " | " << c.temporal << " |\n";
+       << " | " << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
+       << (edges ? c.psnr_edge + " | " + c.psnr_rest + " | " : "") << c.ssim << " | " << c.temporal << " |\n";
   }
   if (first.temporal_error_reference)
     md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
@@ -92,13 +103,18 @@ std::string report_markdown(const ReportTable& table) {
   md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
         "of repeated runs on this machine"
      << (ort ? " (cgsr's own inference; ONNX Runtime: the exported file on the same input)" : "") << ".\n";
+  if (edges) {
+    md << "Edge PSNR: on the HR geometry-edge pixels grown by one pixel";
+    if (with_edges->edge_fraction) md << " (" << fixed(100.0 * *with_edges->edge_fraction, 1) << "% of the pixels)";
+    md << "; Rest PSNR: on the other pixels.\n";
+  }
   return md.str();
 }
 
 std::string report_csv(const std::vector<ReportTable>& tables) {
   std::ostringstream csv;
   csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames,"
-         "onnxruntime_latency_ms\n";
+         "onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n";
   for (const auto& t : tables)
     for (const auto& r : t.rows) {
       csv << t.dataset << "," << t.scale << "," << r.name << "," << (r.cost ? std::to_string(r.cost->params) : "")
@@ -106,7 +122,9 @@ std::string report_csv(const std::vector<ReportTable>& tables) {
           << (r.latency ? fixed(r.latency->median_ms, 4) : "") << "," << fixed(r.psnr, 4) << "," << fixed(r.ssim, 6)
           << "," << (r.temporal_error ? fixed(*r.temporal_error, 6) : "") << ","
           << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size() << ","
-          << (r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 4) : "") << "\n";
+          << (r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 4) : "") << ","
+          << optional_fixed(r.psnr_edge, 4, "") << "," << optional_fixed(r.psnr_rest, 4, "") << ","
+          << optional_fixed(r.edge_fraction, 6, "") << "\n";
     }
   return csv.str();
 }
@@ -122,7 +140,8 @@ void write_report_plot(const std::filesystem::path& path, const ReportTable& tab
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
     const std::string label = std::to_string(i + 1);
-    plot.notes.push_back(label + ". " + r.name + " " + fixed(r.psnr, 2) + " dB");
+    plot.notes.push_back(label + ". " + r.name + " " + fixed(r.psnr, 2) + " dB" +
+                         (r.psnr_edge ? " (edges " + fixed(*r.psnr_edge, 2) + " dB)" : ""));
     if (!r.latency) {
       plot.horizontal_lines.emplace_back(r.psnr, r.name + " (no latency)");
       continue;

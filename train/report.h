@@ -1,7 +1,7 @@
 #pragma once
 // The error-against-run-time report: per scene and scale, one row per evaluated upscaler with
-// Params (k), MACs (G), latency (ms, median on this machine), PSNR, SSIM and temporal error,
-// as Markdown and CSV, plus a PNG plot of PSNR against latency with the Pareto front marked.
+// Params (k), MACs (G), latency (ms, median on this machine), PSNR (with PSNR on geometry edges
+// and on the rest when the results have them), SSIM and temporal error, as Markdown and CSV, plus a PNG plot of PSNR against latency with the Pareto front marked.
 // Every value comes from evaluation results; nothing is typed in.
 
 #include <filesystem>

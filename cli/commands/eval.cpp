@@ -66,7 +66,8 @@ void setup_eval(CLI::App& app) {
 
 namespace {
 // The data set loading only the channels the upscalers read, plus motion vectors for the
-// temporal error: decoding a 1080p frame's other G-buffers would cost more than the metrics.
+// temporal error and edges for the PSNR on geometry edges (evaluate() reads them at HR):
+// decoding a 1080p frame's other G-buffers would cost more than the metrics.
 Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upscaler>>& upscalers, bool temporal) {
   const Dataset all = Dataset::open(path);
   const auto& available = all.info().channels;
@@ -79,6 +80,7 @@ Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upsc
   for (const auto& u : upscalers)
     for (auto c : u->channels()) need(c);
   if (temporal) need(RenderChannel::Motion);
+  need(RenderChannel::Edge);
   std::sort(needed.begin(), needed.end());
   DatasetOpenOptions open;
   open.channels = channel_names(needed);

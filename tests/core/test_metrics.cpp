@@ -1,4 +1,4 @@
-// PSNR and SSIM against independently derived values.
+// PSNR (plain and masked) and SSIM against independently derived values.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
@@ -103,6 +103,85 @@ TEST(Psnr, RejectsBadInput) {
   QualityOptions crop;
   crop.crop_border = 4;
   EXPECT_THROW(psnr(good, good, crop), Error);
+}
+
+TEST(MaskedPsnr, AllTrueMaskIsThePlainPsnr) {
+  torch::manual_seed(5);
+  auto reference = torch::rand({2, 3, 20, 24});
+  auto output = (reference + 0.05 * torch::randn_like(reference)).clamp(0, 1);
+  for (const bool y : {false, true})
+    for (const int crop : {0, 3}) {
+      SCOPED_TRACE(std::to_string(y) + " " + std::to_string(crop));
+      QualityOptions o;
+      o.y_channel = y;
+      o.crop_border = crop;
+      const auto plain = psnr(output, reference, o);
+      const auto masked = masked_psnr(output, reference, torch::ones({20, 24}, torch::kBool), o);
+      ASSERT_EQ(masked.size(), 2u);
+      for (int i = 0; i < 2; ++i) {
+        ASSERT_TRUE(masked[i].inside.has_value());
+        EXPECT_NEAR(*masked[i].inside, plain[i].item<double>(), 1e-9);
+        EXPECT_FALSE(masked[i].outside.has_value());
+        EXPECT_EQ(masked[i].inside_fraction, 1.0);
+      }
+    }
+}
+
+TEST(MaskedPsnr, MatchesAHandComputation) {
+  // 2x2 pixels, 3 channels. Inside: the top row; (0,0) is off by 0.1 in every channel and (0,1)
+  // by 0.2 in the red channel: MSE = (3 * 0.01 + 0.04) / 6. Outside: (1,1) is off by 0.5 in
+  // blue: MSE = 0.25 / 6.
+  auto reference = torch::zeros({1, 3, 2, 2}, torch::kFloat64);
+  auto output = reference.clone();
+  output.index_put_({0, torch::indexing::Slice(), 0, 0}, 0.1);
+  output.index_put_({0, 0, 0, 1}, 0.2);
+  output.index_put_({0, 2, 1, 1}, 0.5);
+  auto mask = torch::tensor({1, 1, 0, 0}, torch::kUInt8).view({1, 2, 2});
+  const auto m = masked_psnr(output, reference, mask).at(0);
+  ASSERT_TRUE(m.inside && m.outside);
+  EXPECT_NEAR(*m.inside, -10 * std::log10(0.07 / 6), 1e-9);
+  EXPECT_NEAR(*m.outside, -10 * std::log10(0.25 / 6), 1e-9);
+  EXPECT_EQ(m.inside_fraction, 0.5);
+}
+
+TEST(MaskedPsnr, EmptySideHasNoValueAndAnExactSideIsInfinite) {
+  torch::manual_seed(6);
+  auto reference = torch::rand({1, 3, 10, 10});
+  auto output = reference.clone();
+  output.slice(2, 5, 10).add_(0.1);  // only the bottom half differs
+  auto nothing = torch::zeros({10, 10}, torch::kBool);
+  const auto none = masked_psnr(output, reference, nothing).at(0);
+  EXPECT_FALSE(none.inside.has_value());
+  ASSERT_TRUE(none.outside.has_value());
+  EXPECT_NEAR(*none.outside, psnr(output, reference).item<double>(), 1e-9);
+  EXPECT_EQ(none.inside_fraction, 0.0);
+
+  // Only border pixels selected: nothing is left inside once the border is cropped.
+  auto border = torch::ones({10, 10}, torch::kBool);
+  border.slice(0, 2, 8).slice(1, 2, 8).fill_(false);
+  QualityOptions crop;
+  crop.crop_border = 2;
+  EXPECT_FALSE(masked_psnr(output, reference, border, crop).at(0).inside.has_value());
+  EXPECT_TRUE(masked_psnr(output, reference, border).at(0).inside.has_value());
+
+  auto top = torch::zeros({10, 10}, torch::kBool);
+  top.slice(0, 0, 5).fill_(true);
+  const auto split = masked_psnr(output, reference, top).at(0);
+  ASSERT_TRUE(split.inside && split.outside);
+  EXPECT_TRUE(std::isinf(*split.inside) && *split.inside > 0);
+  EXPECT_NEAR(*split.outside, 20.0, 1e-4);  // an offset of 0.1 everywhere outside
+}
+
+TEST(MaskedPsnr, RejectsBadMasksAndNonFiniteInputAnywhere) {
+  auto good = torch::rand({1, 3, 8, 8});
+  auto mask = torch::ones({8, 8}, torch::kBool);
+  EXPECT_THROW(masked_psnr(good, good, torch::ones({8, 9}, torch::kBool)), Error);
+  EXPECT_THROW(masked_psnr(good, good, torch::ones({2, 8, 8}, torch::kBool)), Error);
+  EXPECT_THROW(masked_psnr(good, good, torch::ones({8, 8}, torch::kFloat32)), Error);
+  auto bad = good.clone();
+  bad[0][1][7][7] = std::nan("");
+  mask[7][7] = false;  // the NaN is outside the mask: still an error
+  EXPECT_THROW(masked_psnr(bad, good, mask), Error);
 }
 
 TEST(Ssim, IdenticalImagesScoreOne) {

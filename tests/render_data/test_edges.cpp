@@ -1,5 +1,5 @@
 // Edge detection on synthetic G-buffers: depth steps, smooth planes, id changes, creases, and
-// frames where (almost) every pixel is an edge.
+// frames where (almost) every pixel is an edge; the one-pixel dilation of edge maps.
 #include <gtest/gtest.h>
 
 #include <torch/torch.h>
@@ -68,6 +68,28 @@ TEST(Edges, ExtremeDepthRangeStaysFinite) {
   EXPECT_TRUE(torch::isfinite(e).all().item<bool>());
   EXPECT_EQ(e[0][3][4].item<float>(), 1.0f);
   EXPECT_EQ(e.sum().item<float>(), 8.0f);
+}
+
+TEST(DilateEdges, GrowsAPixelToItsThreeByThreeBlock) {
+  auto e = torch::zeros({1, 6, 7}, torch::kUInt8);
+  e[0][2][3] = 1;
+  const auto d = dilate_edges(e);
+  ASSERT_EQ(d.sizes(), e.sizes());
+  EXPECT_EQ(d.scalar_type(), torch::kBool);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 7; ++j)
+      EXPECT_EQ(d[0][i][j].item<bool>(), i >= 1 && i <= 3 && j >= 2 && j <= 4) << i << "," << j;
+}
+
+TEST(DilateEdges, ClampsTheWindowAtTheBorders) {
+  auto e = torch::zeros({5, 4}, torch::kFloat32);  // any type: nonzero is an edge
+  e[0][0] = 1.0f;
+  e[4][3] = 0.5f;
+  const auto d = dilate_edges(e);
+  ASSERT_EQ(d.sizes(), e.sizes());
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 4; ++j)
+      EXPECT_EQ(d[i][j].item<bool>(), (i <= 1 && j <= 1) || (i >= 3 && j >= 2)) << i << "," << j;
 }
 
 }  // namespace

@@ -57,9 +57,34 @@ TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
   EXPECT_NE(csv.find("hall,2,pan,261403,261403000,12.0000,33.4560"), std::string::npos) << csv;
 }
 
+TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
+  ReportTable plain{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}};
+  EXPECT_EQ(report_markdown(plain).find("Edge PSNR"), std::string::npos);
+
+  auto pan = row("pan", 33.456, 12.0, 261403);
+  pan.psnr_edge = 27.891;
+  pan.psnr_rest = 34.012;
+  pan.edge_fraction = 0.0731;
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), pan}};  // bicubic: an older result without them
+  const auto md = report_markdown(t);
+  EXPECT_NE(md.find("| PSNR (dB) | Edge PSNR (dB) | Rest PSNR (dB) | SSIM |"), std::string::npos) << md;
+  EXPECT_NE(md.find("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n"), std::string::npos) << md;
+  EXPECT_NE(md.find("| pan * | 261.4 | 0.26 | 12.00 | 33.46 | 27.89 | 34.01 | 0.9000 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| bicubic * | NA | NA | 0.50 | 30.12 | - | - | 0.9000 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("(7.3% of the pixels)"), std::string::npos) << md;
+
+  const auto csv = report_csv({t});
+  EXPECT_NE(csv.find("onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",27.8910,34.0120,0.073100\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("hall,2,bicubic,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",,,\n"), std::string::npos) << csv;  // bicubic: no ONNX Runtime, no edge figures
+}
+
 TEST(Report, PlotIsAPng) {
   const auto path = std::filesystem::temp_directory_path() / "cgsr-report-plot.png";
-  ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), row("pan", 33, 12.0, 261403), row("fsr", 31, std::nullopt)}};
+  auto pan = row("pan", 33, 12.0, 261403);
+  pan.psnr_edge = 28;
+  ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), pan, row("fsr", 31, std::nullopt)}};
   write_report_plot(path, t);
   const auto bytes = read_file(path);
   ASSERT_GT(bytes.size(), 1000u);
