@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <numeric>
+#include <sstream>
 
 #include "core/error.h"
 
@@ -76,6 +78,15 @@ std::pair<int, int> parse_size(const std::string& text, const std::string& what)
   const int h = std::stoi(parts[1]);
   if (w <= 0 || h <= 0) throw Error(what, "width and height must be positive, got '" + text + "'");
   return {w, h};
+}
+
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "NA";
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
 }
 
 }  // namespace cgsr

@@ -24,4 +24,7 @@ std::vector<std::string> split(const std::string& text, char separator);
 // Parses "WxH" (e.g. "320x240") into width and height; throws cgsr::Error naming `what`.
 std::pair<int, int> parse_size(const std::string& text, const std::string& what);
 
+// `v` with `digits` decimals ("25.412"); "NA" when not finite.
+std::string fixed(double v, int digits);
+
 }  // namespace cgsr

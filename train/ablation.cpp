@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -200,15 +199,6 @@ AblationResult run_ablation(const SRNetworkImpl& parent, const Dataset& data, co
 }
 
 namespace {
-
-std::string fixed(double v, int digits) {
-  if (!std::isfinite(v)) return "NA";
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 std::string signed_fixed(double v, int digits) { return (std::isfinite(v) && v >= 0 ? "+" : "") + fixed(v, digits); }
 

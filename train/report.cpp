@@ -8,17 +8,10 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/plot.h"
+#include "core/text.h"
 
 namespace cgsr {
 namespace {
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
-
 struct Cells {
   std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
 };

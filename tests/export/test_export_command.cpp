@@ -22,7 +22,7 @@ TEST(ExportCommand, ExportsAModelFileAndVerifiesItInOnnxRuntimeAndOpenCv) {
                                 " --format onnx --input 12x10 --verify --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NO_THROW(check_onnx_file(out));
-  EXPECT_NE(r.out.find("lr_render_info [1, 6, 20, 24]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("hr_render_info [1, 6, 20, 24]"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("ONNX checker ok"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("2 passed, 0 failed, 0 skipped"), std::string::npos) << r.out;
   for (const char* runtime : {"onnxruntime", "opencv-dnn"}) EXPECT_NE(r.out.find(runtime), std::string::npos);

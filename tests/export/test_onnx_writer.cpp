@@ -149,7 +149,7 @@ TEST(OnnxWriter, RenderInfoInputHasOnlyTheModelsChannelsAtItsResolution) {
   SRNetwork net = test::build_network(spec, 4);
   const auto m = model_of(net->describe(), fixed(12, 10));
   ASSERT_EQ(m.graph().input_size(), 2);
-  EXPECT_EQ(m.graph().input(1).name(), "lr_render_info");
+  EXPECT_EQ(m.graph().input(1).name(), "hr_render_info");
   EXPECT_EQ(shape(m.graph().input(1)), (std::vector<std::string>{"1", "2", "20", "24"}));
   EXPECT_EQ(nodes_of(m, "AveragePool").size(), 1u);
   // The RIT gate (a channel affine) is a Mul by a [1, C, 1, 1] initializer.

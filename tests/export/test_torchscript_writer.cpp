@@ -36,7 +36,7 @@ TEST(TorchScriptWriter, ModuleHoldsTheGraphTensorsAndComputesOurForward) {
   EXPECT_EQ(static_cast<int64_t>(params.size()), static_cast<int64_t>(net->named_parameters().size()));
 
   const std::string source = torchscript_source(g);
-  EXPECT_NE(source.find("def forward(self, lr_color: Tensor, lr_render_info: Tensor) -> Tensor:"), std::string::npos);
+  EXPECT_NE(source.find("def forward(self, lr_color: Tensor, hr_render_info: Tensor) -> Tensor:"), std::string::npos);
   EXPECT_NE(source.find("torch.pixel_shuffle("), std::string::npos);
   EXPECT_NE(source.find("torch.avg_pool2d("), std::string::npos);
 
@@ -64,7 +64,7 @@ TEST(TorchScriptWriter, SavedFilesLoadBackWithTheirMetadata) {
   EXPECT_TRUE(torch::equal(out, infer(*net, color)));
   // Inputs are matched by name: a wrong or missing one is a clear error.
   EXPECT_THROW(run_torchscript_libtorch(exported.file, {{"color", color}}), Error);
-  EXPECT_THROW(run_torchscript_libtorch(exported.file, {{"lr_color", color}, {"lr_render_info", color}}), Error);
+  EXPECT_THROW(run_torchscript_libtorch(exported.file, {{"lr_color", color}, {"hr_render_info", color}}), Error);
   std::filesystem::remove_all(dir);
 }
 

@@ -110,9 +110,7 @@ inline torch::Tensor masked_dense(const SRNetworkImpl& net, const ChannelSelecti
     }
     op.weight = w;
   }
-  std::vector<std::pair<std::string, torch::Tensor>> in = {{"color", color}};
-  if (info.defined()) in.emplace_back("info", info);
-  return graph::run(g, in).front().second;
+  return graph::run(g, network_inputs(g, color, info)).front().second;
 }
 
 inline double max_diff(const torch::Tensor& a, const torch::Tensor& b) {
