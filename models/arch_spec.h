@@ -74,6 +74,7 @@ struct RitSpec {
   // hr_unshuffle) and the branch at the HR features (hr_fuse).
   bool feature_branch() const { return source != "hr_fuse"; }
   bool hr_branch() const { return source == "hr_fuse" || source == "hr_unshuffle+hr_fuse"; }
+  bool unshuffles() const { return source == "hr_unshuffle" || source == "hr_unshuffle+hr_fuse"; }
   // Every source except lr reads the rendering information at the output resolution.
   bool reads_hr() const { return source != "lr"; }
   bool operator==(const RitSpec& o) const {

@@ -28,7 +28,7 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     : concat_(rit.fusion == "concat"),
       info_factor_(rit.reads_hr() ? scale : 1),
       pool_factor_(rit.source == "hr_pooled" ? scale : 1),
-      stride_(rit.source == "hr_unshuffle" || rit.source == "hr_unshuffle+hr_fuse" ? scale : 1),
+      stride_(rit.unshuffles() ? scale : 1),
       upsample_factor_(features.factor) {
   const int64_t c = total_width(rit.render_channels());
   CGSR_CHECK(c > 0 && rit.width > 0 && rit.hr_width > 0, "RIT needs channels and positive widths");
@@ -52,15 +52,24 @@ torch::Tensor RitBlockImpl::gate_info(const torch::Tensor& info) const {
   return graph::apply_affine(x, gate, {});
 }
 
+torch::Tensor RitBlockImpl::join(const torch::Tensor& features, const torch::Tensor& x, torch::nn::Conv2d& fusion) {
+  return features + fusion(concat_ ? torch::cat({features, x}, 1) : x);
+}
+
+int RitBlockImpl::describe_join(graph::Builder& g, const std::string& name, const torch::nn::Conv2d& fusion,
+                                int features, int x) const {
+  const int fused = describe_conv(g, name, fusion, concat_ ? g.concat({features, x}) : x, g.value(features).layout);
+  return g.add(features, fused);
+}
+
 torch::Tensor RitBlockImpl::fuse_features(const torch::Tensor& features, const torch::Tensor& gated) {
   auto x = torch::leaky_relu(conv(gated), kLeakySlope);
   if (upsample_factor_ > 1) x = graph::apply_resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
-  return features + fuse(concat_ ? torch::cat({features, x}, 1) : x);
+  return join(features, x, fuse);
 }
 
 torch::Tensor RitBlockImpl::fuse_hr(const torch::Tensor& hr_features, const torch::Tensor& gated) {
-  const auto x = torch::leaky_relu(hr_conv(gated), kLeakySlope);
-  return hr_features + hr_fuse(concat_ ? torch::cat({hr_features, x}, 1) : x);
+  return join(hr_features, torch::leaky_relu(hr_conv(gated), kLeakySlope), hr_fuse);
 }
 
 int RitBlockImpl::describe_gate(graph::Builder& g, int info) const {
@@ -70,20 +79,17 @@ int RitBlockImpl::describe_gate(graph::Builder& g, int info) const {
 
 int RitBlockImpl::describe_features(graph::Builder& g, int features, int gated) const {
   // Kernel 3s, padding s (one LR pixel), stride s.
-  int x = g.conv("conv", gated, conv->weight, conv->bias, /*padding=*/stride_, graph::group_layout("rit", conv->weight.size(0)),
-                 /*trainable=*/true, stride_);
+  int x = g.conv("conv", gated, conv->weight, conv->bias, /*padding=*/stride_,
+                 graph::group_layout("rit", conv->weight.size(0)), /*trainable=*/true, stride_);
   x = g.leaky_relu(x, kLeakySlope);
   if (upsample_factor_ > 1) x = g.resize(x, upsample_factor_, graph::ResizeMode::Bilinear);
-  const int fused = describe_conv(g, "fuse", fuse, concat_ ? g.concat({features, x}) : x, g.value(features).layout);
-  return g.add(features, fused);
+  return describe_join(g, "fuse", fuse, features, x);
 }
 
 int RitBlockImpl::describe_hr(graph::Builder& g, int hr_features, int gated) const {
   const int x = g.leaky_relu(
       describe_conv(g, "hr_conv", hr_conv, gated, graph::group_layout("rit_hr", hr_conv->weight.size(0))), kLeakySlope);
-  const int fused =
-      describe_conv(g, "hr_fuse", hr_fuse, concat_ ? g.concat({hr_features, x}) : x, g.value(hr_features).layout);
-  return g.add(hr_features, fused);
+  return describe_join(g, "hr_fuse", hr_fuse, hr_features, x);
 }
 
 }  // namespace cgsr

@@ -69,6 +69,11 @@ class RitBlockImpl : public torch::nn::Module {
   torch::nn::Conv2d hr_conv{nullptr}, hr_fuse{nullptr};  // the HR part
 
  private:
+  // features + fusion(cat(features, x)) or features + fusion(x), and its graph mirror.
+  torch::Tensor join(const torch::Tensor& features, const torch::Tensor& x, torch::nn::Conv2d& fusion);
+  int describe_join(graph::Builder& g, const std::string& name, const torch::nn::Conv2d& fusion, int features,
+                    int x) const;
+
   bool concat_;
   int64_t info_factor_;      // 1 (lr) or the scale
   int64_t pool_factor_;      // hr_pooled: the scale

@@ -63,7 +63,7 @@ TEST(Evaluation, EdgeAndRestPsnrMatchADirectComputation) {
   for (const auto& f : r.frames) {
     SCOPED_TRACE(f.frame);
     // The same figures from the dataset's HR edge map, grown by a 3x3 max pool.
-    const Batch b = frame_batch(data, f.frame, 2, {});
+    const Batch b = frame_batch(data, f.frame, 2, {}, DepthEncoding::Log);
     const auto sr = upscaler->upscale(b).clamp(0.0, 1.0).to(torch::kFloat64);
     const auto hr = b.hr_color.to(torch::kFloat64);
     const auto edge = data.frame(f.frame, data.resolution_index({128, 96}))->edge.to(torch::kFloat32);

@@ -8,7 +8,8 @@
 //   RCAS: robust contrast-adaptive sharpening. A 5-tap cross whose negative lobe is limited so
 //         that it never pushes a pixel outside the range of its neighbours.
 // Input and output are display-referred colour in [0,1] (FSR expects perceptual space); values
-// outside [0,1] are clamped first. The RCAS noise-removal option is not implemented.
+// outside [0,1] are clamped first. RCAS is FSR 1.0's default configuration: its compile-time
+// noise-removal variant (off by default there, for grainy content) is left out on purpose.
 // fsr1_easu and upscale_fsr1 reject NaN/Inf input (cgsr::Error). fsr1_rcas does not check: a NaN
 // texel turns its 5-texel cross NaN (in its own channel, maybe in the others) and nothing else.
 // CPU only; float and double are computed in their own precision, half and bfloat16 in float.
