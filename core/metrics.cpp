@@ -128,30 +128,54 @@ double sum_squared_error(const T* a, const T* b, int64_t count) {
 
 struct SplitError {
   double inside = 0, outside = 0;
+  int64_t inside_pixels = 0;
 };
 
-// Squared error of one image (c planes of h x w) split by a h x w mask, parallel over rows.
+// Squared error of one image (c planes of h x w) split by a mask of h x w bytes (nonzero =
+// inside) whose rows are `mask_stride` apart, parallel over rows.
 template <class T>
-SplitError masked_squared_error(const T* a, const T* b, const uint8_t* mask, int64_t c, int64_t h, int64_t w) {
+SplitError masked_squared_error(const T* a, const T* b, const uint8_t* mask, int64_t mask_stride, int64_t c,
+                                int64_t h, int64_t w) {
   return tbb::parallel_reduce(
       tbb::blocked_range<int64_t>(0, h), SplitError{},
       [&](const tbb::blocked_range<int64_t>& rows, SplitError sum) {
+        // Per row: the squared error summed over channels into a buffer (a loop without a
+        // reduction, which the compiler vectorizes), then one pass splitting it by the mask.
+        // Local accumulators: the uint8 mask may alias anything, so sums kept in `sum` would be
+        // stored and reloaded at every pixel.
+        std::vector<double> error(static_cast<size_t>(w));
+        double inside = 0, outside = 0;
+        int64_t pixels = 0;
         for (int64_t y = rows.begin(); y < rows.end(); ++y) {
-          const uint8_t* m = mask + y * w;
+          std::fill(error.begin(), error.end(), 0.0);
+          double* e = error.data();
           for (int64_t ch = 0; ch < c; ++ch) {
             const T* ra = a + (ch * h + y) * w;
             const T* rb = b + (ch * h + y) * w;
             for (int64_t x = 0; x < w; ++x) {
               const double d = static_cast<double>(ra[x]) - static_cast<double>(rb[x]);
-              (m[x] ? sum.inside : sum.outside) += d * d;
+              e[x] += d * d;
+            }
+          }
+          const uint8_t* m = mask + y * mask_stride;
+          for (int64_t x = 0; x < w; ++x) {
+            if (m[x]) {
+              inside += e[x];
+              ++pixels;
+            } else {
+              outside += e[x];
             }
           }
         }
+        sum.inside += inside;
+        sum.outside += outside;
+        sum.inside_pixels += pixels;
         return sum;
       },
       [](SplitError l, const SplitError& r) {
         l.inside += r.inside;
         l.outside += r.outside;
+        l.inside_pixels += r.inside_pixels;
         return l;
       });
 }
@@ -199,27 +223,29 @@ torch::Tensor ssim(const torch::Tensor& output, const torch::Tensor& reference, 
 std::vector<MaskedPsnr> masked_psnr(const torch::Tensor& output, const torch::Tensor& reference,
                                     const torch::Tensor& mask, const QualityOptions& options) {
   const auto [a, b] = prepare(output, reference, options, "masked PSNR");
-  auto m = mask.dim() == 3 && mask.size(0) == 1 ? mask.squeeze(0) : mask;
-  if (m.dim() != 2 || m.size(0) != output.size(-2) || m.size(1) != output.size(-1))
+  if (!(mask.dim() == 2 || (mask.dim() == 3 && mask.size(0) == 1)) || mask.size(-2) != output.size(-2) ||
+      mask.size(-1) != output.size(-1))
     throw Error("masked PSNR", "the mask must be [H,W] or [1,H,W] at the images' size " + shape_string(output) +
                                    ", got " + shape_string(mask));
-  if (m.scalar_type() != torch::kBool && m.scalar_type() != torch::kUInt8)
-    throw Error("masked PSNR", std::string("the mask must be bool or uint8, got ") + c10::toString(m.scalar_type()));
-  const int64_t crop = options.crop_border;  // prepare() checked it against the size
-  m = (m.slice(0, crop, m.size(0) - crop).slice(1, crop, m.size(1) - crop) != 0).to(torch::kUInt8).contiguous();
+  if (mask.scalar_type() != torch::kBool && mask.scalar_type() != torch::kUInt8)
+    throw Error("masked PSNR", std::string("the mask must be bool or uint8, got ") + c10::toString(mask.scalar_type()));
+  // Both types are one byte per pixel: the loops read the bytes and crop by offset. (No torch
+  // operation here: its OpenMP workers would still be spinning while the TBB loop runs.)
+  const auto m = mask.contiguous();
+  const int64_t crop = options.crop_border, stride = mask.size(-1);  // prepare() checked the crop
+  const auto* bytes = reinterpret_cast<const uint8_t*>(m.data_ptr()) + crop * stride + crop;
   const int64_t n = a.size(0), c = a.size(1), h = a.size(2), w = a.size(3);
-  const int64_t inside = m.sum().item<int64_t>(), outside = h * w - inside;
   std::vector<MaskedPsnr> out(n);
   for (int64_t i = 0; i < n; ++i) {
     const int64_t offset = i * c * h * w;
     const SplitError e =
         a.scalar_type() == torch::kFloat64
-            ? masked_squared_error(a.data_ptr<double>() + offset, b.data_ptr<double>() + offset, m.data_ptr<uint8_t>(), c, h, w)
-            : masked_squared_error(a.data_ptr<float>() + offset, b.data_ptr<float>() + offset, m.data_ptr<uint8_t>(), c, h, w);
+            ? masked_squared_error(a.data_ptr<double>() + offset, b.data_ptr<double>() + offset, bytes, stride, c, h, w)
+            : masked_squared_error(a.data_ptr<float>() + offset, b.data_ptr<float>() + offset, bytes, stride, c, h, w);
     if (!std::isfinite(e.inside) || !std::isfinite(e.outside)) non_finite("masked PSNR");
-    out[i].inside = psnr_of(e.inside, inside * c);
-    out[i].outside = psnr_of(e.outside, outside * c);
-    out[i].inside_fraction = static_cast<double>(inside) / static_cast<double>(h * w);
+    out[i].inside = psnr_of(e.inside, e.inside_pixels * c);
+    out[i].outside = psnr_of(e.outside, (h * w - e.inside_pixels) * c);
+    out[i].inside_fraction = static_cast<double>(e.inside_pixels) / static_cast<double>(h * w);
   }
   return out;
 }
