@@ -2,6 +2,8 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include <optional>
+
 namespace cgsr::cli {
 
 config::Schema<VerdictOptions> verdict_schema() {
@@ -12,13 +14,17 @@ config::Schema<VerdictOptions> verdict_schema() {
   s.field("max_prune_loss_db", &VerdictOptions::max_prune_loss_db,
           "test PSNR the pruned network may lose against the CG-optimized one")
       .at_least(0);
+  s.field("min_enhance_gain_db", &VerdictOptions::min_enhance_gain_db,
+          "test PSNR the CG-enhanced network must gain over the plain backbone trained as long (may be negative)");
+  s.field("min_enhance_edge_gain_db", &VerdictOptions::min_enhance_edge_gain_db,
+          "the same gain on geometry-edge pixels (the HR edge map dilated by 1 pixel)");
   s.field("fail_run", &VerdictOptions::fail_run, "exit with an error when a check fails");
   return s;
 }
 
 std::vector<const EvalResult*> PipelineResults::networks() const {
   std::vector<const EvalResult*> out;
-  for (const EvalResult* r : {backbone, cg_enhanced, cg_optimized, pruned})
+  for (const EvalResult* r : {backbone, control, cg_enhanced, cg_optimized, pruned})
     if (r) out.push_back(r);
   return out;
 }
@@ -55,6 +61,19 @@ void check_cuts(Verdict& v, const std::string& stage, const EvalResult& before, 
                                   after.psnr, -loss)});
 }
 
+// "a gains at least min_gain dB over b" on one PSNR (overall or a region of the frame); a PSNR
+// that was not evaluated fails the check.
+void check_gain(Verdict& v, const std::string& region, const EvalResult& a, const EvalResult& b,
+                std::optional<double> a_psnr, std::optional<double> b_psnr, double min_gain) {
+  const std::string claim = fmt::format("{} gains at least {:g} dB {} over {}", a.name, min_gain, region, b.name);
+  if (!a_psnr || !b_psnr) {
+    v.checks.push_back({claim, false, "PSNR " + region + " was not evaluated"});
+    return;
+  }
+  v.checks.push_back({claim, *a_psnr - *b_psnr >= min_gain,
+                      fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", *a_psnr, *b_psnr, *a_psnr - *b_psnr)});
+}
+
 }  // namespace
 
 Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) {
@@ -65,10 +84,12 @@ Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) 
                           fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", n->psnr, r.bicubic->psnr,
                                       n->psnr - r.bicubic->psnr)});
   }
-  if (r.backbone && r.cg_enhanced)
-    v.checks.push_back({"CG-enhanced at least as good as " + r.backbone->name, r.cg_enhanced->psnr >= r.backbone->psnr,
-                        fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", r.cg_enhanced->psnr,
-                                    r.backbone->psnr, r.cg_enhanced->psnr - r.backbone->psnr)});
+  if (r.control && r.cg_enhanced) {
+    check_gain(v, "overall", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr, r.control->psnr,
+               options.min_enhance_gain_db);
+    check_gain(v, "on geometry edges", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr_edge, r.control->psnr_edge,
+               options.min_enhance_edge_gain_db);
+  }
   if (r.cg_enhanced && r.cg_optimized) check_cuts(v, "search", *r.cg_enhanced, *r.cg_optimized, options.max_search_loss_db);
   if (r.cg_optimized && r.pruned) check_cuts(v, "pruning", *r.cg_optimized, *r.pruned, options.max_prune_loss_db);
   return v;

@@ -2,7 +2,9 @@
 // The verdict of `cgsr run`: does this run show the CGSR story? Checks, on the held-out
 // evaluations of one run (all measured in the same process):
 //   - every network beats bicubic PSNR;
-//   - the CG-enhanced network is at least as good as the plain backbone it started from;
+//   - the CG-enhanced network beats the plain backbone trained on for the same steps (the
+//     control: what the extra training alone gives) by `min_enhance_gain_db` overall and by
+//     `min_enhance_edge_gain_db` on geometry-edge pixels, where rendering information should help;
 //   - the search cuts params, MACs and latency of the CG-enhanced network, losing at most
 //     `max_search_loss_db` PSNR;
 //   - pruning cuts params, MACs and latency of the searched network, losing at most
@@ -21,6 +23,8 @@ namespace cgsr::cli {
 struct VerdictOptions {
   double max_search_loss_db = 0.3;  // PSNR the CG-optimized network may lose against its parent
   double max_prune_loss_db = 0.3;   // PSNR the pruned network may lose against its input
+  double min_enhance_gain_db = 0;       // PSNR the CG-enhanced network must gain over the control
+  double min_enhance_edge_gain_db = 0;  // the same on geometry-edge pixels
   bool fail_run = true;             // a failed check makes `cgsr run` exit with an error
 };
 config::Schema<VerdictOptions> verdict_schema();
@@ -29,6 +33,7 @@ config::Schema<VerdictOptions> verdict_schema();
 struct PipelineResults {
   const EvalResult* bicubic = nullptr;
   const EvalResult* backbone = nullptr;      // plain backbone (e.g. PAN x2)
+  const EvalResult* control = nullptr;       // the backbone trained on as long as the CG-enhanced one
   const EvalResult* cg_enhanced = nullptr;   // backbone + RIT
   const EvalResult* cg_optimized = nullptr;  // the search's pick, trained longer
   const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network

@@ -32,7 +32,7 @@ namespace fs = std::filesystem;
 namespace cgsr::cli {
 
 const std::vector<std::string>& pipeline_stages() {
-  static const std::vector<std::string> stages = {"render", "train",  "enhance", "search",
+  static const std::vector<std::string> stages = {"render", "train",  "enhance", "control", "search",
                                                   "prune",  "export", "eval",    "report"};
   return stages;
 }
@@ -238,6 +238,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   const std::string data_path = render ? stages.dir("render").string() : options.data;
   const fs::path backbone_file = stages.dir("train") / "model.cgsr";
   const fs::path enhanced_file = stages.dir("enhance") / "model.cgsr";
+  const fs::path control_file = stages.dir("control") / "model.cgsr";
   const fs::path searched_file = stages.dir("search") / "model.cgsr";
   const fs::path pruned_file = stages.dir("prune") / "pruned.cgsr";
   RenderOptions scene;
@@ -253,6 +254,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   enhance_filled["model"] = backbone_file.string();
   TrainOptions enhanced = parse_stage(options.enhance, train_schema(), enhance_filled, "enhance");
   enhanced.enhance.enabled = true;
+  TrainOptions control = enhanced;  // same start, schedule, loss and seed; no rendering information
+  control.enhance.enabled = false;
   YAML::Node search_filled = YAML::Clone(with_data);
   search_filled["parent"] = enhanced_file.string();
   SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
@@ -293,6 +296,15 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
                                     return run_train(enhanced, train_schema().emit(enhanced), dir);
                                   });
   record("enhance", enhance);
+
+  // control: the plain backbone trained on as long as the CG-enhanced network was
+  control.name = trained.summary.at("name").get<std::string>() + " (control)";
+  const auto controlled = stages.run("control", train_schema().emit(control), {data_hash, trained.hash},
+                                     [&](RunDir& dir, bool resume) {
+                                       control.resume = resume;
+                                       return run_train(control, train_schema().emit(control), dir);
+                                     });
+  record("control", controlled);
 
   // search: CG-enhanced -> CG-optimized
   const auto searched = stages.run("search", search_command_schema().emit(search), {data_hash, enhance.hash},
@@ -345,7 +357,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   });
   record("export", exported);
 
-  // eval: classic baselines, the backbone and the CG-enhanced network (prune evaluated the rest)
+  // eval: classic baselines, the backbone, the control and the CG-enhanced network (prune
+  // evaluated the rest)
   EvalCommandOptions evaluation;
   evaluation.seed = options.seed;
   evaluation.threads = options.threads;
@@ -356,8 +369,10 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   for (const auto& b : options.baselines)
     if (b != "bicubic") evaluation.models.push_back(b);
   evaluation.models.push_back(backbone_file.string());
+  evaluation.models.push_back(control_file.string());
   evaluation.models.push_back(enhanced_file.string());
-  const auto evaluated = stages.run("eval", eval_schema().emit(evaluation), {data_hash, trained.hash, enhance.hash},
+  const auto evaluated = stages.run("eval", eval_schema().emit(evaluation),
+                                    {data_hash, trained.hash, controlled.hash, enhance.hash},
                                     [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
   record("eval", evaluated);
 
@@ -367,6 +382,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   const std::string searched_name = pruned.summary.at("name").get<std::string>();
   const std::map<std::string, fs::path> model_files = {
       {trained.summary.at("name").get<std::string>(), backbone_file},
+      {control.name, control_file},
       {enhance.summary.at("name").get<std::string>(), enhanced_file},
       {searched_name, searched_file},
       {searched_name + " MMP", stages.dir("prune") / "mmp.cgsr"},
@@ -414,10 +430,11 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   PipelineResults roles;
   roles.bicubic = find_result(evaluations, "bicubic");
   roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
+  roles.control = find_result(evaluations, control.name);
   roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
   roles.cg_optimized = find_result(evaluations, searched_name);
   roles.pruned = find_result(evaluations, searched_name + " hybrid");
-  if (!roles.bicubic || !roles.backbone || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
+  if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
     throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + searched_name + ")",
                 ErrorKind::Internal);
   const Verdict verdict = judge_pipeline(roles, options.verdict);

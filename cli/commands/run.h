@@ -4,10 +4,12 @@
 //   render   the scene (or use an existing data set)          DIR/data
 //   train    the plain backbone                               DIR/train
 //   enhance  backbone + RIT + geometry head (CG-enhanced)     DIR/enhance
+//   control  the backbone trained on with the enhance stage's schedule and seed: what the
+//            extra training alone gives, which the verdict compares CG-enhanced with   DIR/control
 //   search   CG-enhanced -> CG-optimized                      DIR/search
 //   prune    hybrid pruning + magnitude baseline              DIR/prune
 //   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
-//   eval     classic baselines, backbone and CG-enhanced on the test split          DIR/eval
+//   eval     classic baselines, backbone, control and CG-enhanced on the test split  DIR/eval
 //   report   every model timed again side by side; table, plot  DIR/report/report.md
 //            and the verdict (cli/pipeline_verdict.h)             DIR/verdict.txt
 //

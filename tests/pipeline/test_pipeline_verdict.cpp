@@ -8,10 +8,12 @@ using namespace cgsr;
 using namespace cgsr::cli;
 
 namespace {
-EvalResult result(const std::string& name, double psnr, int64_t params, int64_t macs, double latency_ms) {
+EvalResult result(const std::string& name, double psnr, int64_t params, int64_t macs, double latency_ms,
+                  double psnr_edge = 20.0) {
   EvalResult r;
   r.name = name;
   r.psnr = psnr;
+  r.psnr_edge = psnr_edge;
   if (params > 0) {
     Complexity c;
     c.params = params;
@@ -36,20 +38,22 @@ const VerdictCheck* find(const Verdict& v, const std::string& claim) {
 struct Story {
   EvalResult bicubic = result("bicubic", 24.0, 0, 0, 2.0);
   EvalResult pan = result("PAN", 26.0, 272000, 20000000, 100.0);
-  EvalResult cg = result("CG", 26.2, 280000, 21000000, 110.0);
+  EvalResult control = result("PAN on", 26.05, 272000, 20000000, 100.0, 20.0);
+  EvalResult cg = result("CG", 26.2, 280000, 21000000, 110.0, 20.5);
   EvalResult opt = result("OPT", 26.1, 150000, 11000000, 60.0);
   EvalResult pruned = result("P", 26.0, 60000, 4000000, 30.0);
-  PipelineResults roles() const { return {&bicubic, &pan, &cg, &opt, &pruned}; }
+  PipelineResults roles() const { return {&bicubic, &pan, &control, &cg, &opt, &pruned}; }
 };
 }  // namespace
 
 TEST(PipelineVerdict, TheExpectedStoryPassesEveryCheck) {
   const Story s;
   const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
-  // 4 networks above bicubic, CG >= PAN, and 4 checks each for search and pruning.
-  EXPECT_EQ(v.checks.size(), 4u + 1u + 4u + 4u);
+  // 5 networks above bicubic, CG's gain over the control overall and on edges, and 4 checks
+  // each for search and pruning.
+  EXPECT_EQ(v.checks.size(), 5u + 2u + 4u + 4u);
   EXPECT_TRUE(v.passed()) << v.text();
-  EXPECT_NE(v.text().find("all 13 checks pass"), std::string::npos);
+  EXPECT_NE(v.text().find("all 15 checks pass"), std::string::npos);
   EXPECT_EQ(v.to_json()["passed"], true);
 }
 
@@ -64,9 +68,22 @@ TEST(PipelineVerdict, EachClaimFailsOnItsOwn) {
   }
   {
     Story s;
-    s.cg.psnr = 25.99;
+    s.cg.psnr = 26.04;  // above its shorter-trained parent, below the control trained as long
     const Verdict v = judge_pipeline(s.roles(), VerdictOptions{});
-    EXPECT_FALSE(find(v, "CG-enhanced at least as good as PAN")->passed);
+    EXPECT_FALSE(find(v, "CG gains at least 0 dB overall over PAN on")->passed);
+    EXPECT_TRUE(find(v, "CG gains at least 0 dB on geometry edges over PAN on")->passed);
+    EXPECT_EQ(v.failed(), 1) << v.text();
+  }
+  {
+    Story s;  // CG gains 0.15 dB overall and 0.5 dB on edges
+    VerdictOptions o;
+    o.min_enhance_gain_db = 0.2;
+    o.min_enhance_edge_gain_db = 0.5;
+    const Verdict v = judge_pipeline(s.roles(), o);
+    EXPECT_FALSE(find(v, "CG gains at least 0.2 dB overall over PAN on")->passed);
+    EXPECT_TRUE(find(v, "CG gains at least 0.5 dB on geometry edges over PAN on")->passed);
+    s.cg.psnr_edge = 20.49;
+    EXPECT_FALSE(find(judge_pipeline(s.roles(), o), "CG gains at least 0.5 dB on geometry edges over PAN on")->passed);
   }
   {
     Story s;

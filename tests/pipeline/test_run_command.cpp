@@ -54,7 +54,7 @@ fs::path write_config(const fs::path& dir) {
 // Stage name -> "ran" / "skipped", from the log lines of one cgsr run.
 std::map<std::string, std::string> stage_actions(const std::string& log) {
   std::map<std::string, std::string> out;
-  for (const std::string stage : {"render", "train", "enhance", "search", "prune", "export", "eval", "report"}) {
+  for (const std::string stage : {"render", "train", "enhance", "control", "search", "prune", "export", "eval", "report"}) {
     if (log.find("] " + stage + ": up to date") != std::string::npos)
       out[stage] = "skipped";
     else if (log.find("] " + stage + ": done in") != std::string::npos)
@@ -83,28 +83,28 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   const CliResult first = run_cgsr(args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   for (const auto& [stage, action] : stage_actions(first.err)) EXPECT_EQ(action, "ran") << stage;
-  EXPECT_EQ(stage_actions(first.err).size(), 8u) << first.err;
-  for (const std::string stage : {"data", "train", "enhance", "search", "prune", "export", "eval", "report"})
+  EXPECT_EQ(stage_actions(first.err).size(), 9u) << first.err;
+  for (const std::string stage : {"data", "train", "enhance", "control", "search", "prune", "export", "eval", "report"})
     EXPECT_TRUE(read_json(out / stage / "stage.json")["done"].get<bool>()) << stage;
-  for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
+  for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "control/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
                                  "export/cg_optimized.onnx", "export/pruned.onnx", "export/pruned.pt",
                                  "report/report.md", "verdict.txt", "results.json", "log.txt"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
 
   // The report holds every model of the pipeline; the verdict judges them.
   const std::string report = slurp(out / "report" / "report.md");
-  for (const std::string row : {"bicubic", "nearest", "PAN x2", "CG-enhanced PAN x2", "CG-optimized PAN x2",
+  for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2", "CG-optimized PAN x2",
                                 "CG-optimized PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
     EXPECT_NE(report.find("| " + row + " "), std::string::npos) << row << "\n" << report;
   const auto results = read_json(out / "results.json");
-  EXPECT_GE(results["verdict"]["checks"].size(), 13u);
+  EXPECT_GE(results["verdict"]["checks"].size(), 15u);
   EXPECT_NE(first.out.find("verdict:"), std::string::npos);
 
   // A rerun finds every stage finished.
   const CliResult again = run_cgsr(args);
   ASSERT_EQ(again.exit_code, 0) << again.err;
   for (const auto& [stage, action] : stage_actions(again.err)) EXPECT_EQ(action, "skipped") << stage;
-  EXPECT_EQ(stage_actions(again.err).size(), 8u);
+  EXPECT_EQ(stage_actions(again.err).size(), 9u);
   EXPECT_NE(again.out.find("verdict:"), std::string::npos);  // still printed
 
   // --from eval reruns eval and report only.
@@ -114,7 +114,7 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   // A changed search config reruns search and what depends on it, not the trainings before it,
   // nor eval (which reads neither search nor prune).
   expect_actions(run_cgsr(args + " --set search.final.steps=3"),
-                 {{"train", "skipped"}, {"enhance", "skipped"}, {"search", "ran"}, {"prune", "ran"},
+                 {{"train", "skipped"}, {"enhance", "skipped"}, {"control", "skipped"}, {"search", "ran"}, {"prune", "ran"},
                   {"eval", "skipped"}, {"report", "ran"}});
   fs::remove_all(dir);
 }
