@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -120,12 +121,20 @@ class Runner {
   AblationRun run_once(const AblationVariant& v, int64_t seed) {
     const auto dir = dir_ / "variants" / slug(v.name) / ("seed" + std::to_string(seed));
     const auto record = dir / "run.json";
+    // A run trained under other settings (an edited config) is not resumed or reused.
+    const auto stamp = dir / "settings.yaml";
+    const std::string settings = run_settings(v, seed);
+    if (std::filesystem::exists(stamp) && read_file(stamp) != settings) {
+      spdlog::warn("ablation: {} seed {} was trained under other settings; training it again", v.name, seed);
+      std::filesystem::remove_all(dir);
+    }
+    std::filesystem::create_directories(dir);
+    write_file_atomic(stamp, settings);
     if (std::filesystem::exists(record)) {
       const auto j = nlohmann::ordered_json::parse(read_file(record));
       spdlog::info("ablation: {} seed {} already done", v.name, seed);
       return run_from_json(j, record.string());
     }
-    std::filesystem::create_directories(dir);
     spdlog::info("ablation: training {} ({}), seed {}", v.name, spec_summary(v.spec), seed);
     seed_everything(static_cast<uint64_t>(seed));  // the fresh RIT and the batches depend on the seed only
     SRNetwork net = inherit(parent_, v.spec).network;
@@ -150,6 +159,19 @@ class Runner {
     write_file_atomic(record, run_to_json(r).dump(2) + "\n");
     std::filesystem::remove(dir / "checkpoint.pt");  // the run is recorded; the model file stays
     return r;
+  }
+
+  // Everything a (variant, seed) run's result depends on besides the parent and the data.
+  std::string run_settings(const AblationVariant& v, int64_t seed) const {
+    YAML::Node node;
+    node["spec"] = YAML::Load(spec_to_yaml(v.spec));
+    node["seed"] = seed;
+    node["schedule"] = schedule_schema().emit(options_.schedule);
+    node["loss"] = loss_schema().emit(options_.loss);
+    node["eval"] = eval_schema_fields().emit(options_.eval);
+    YAML::Emitter out;
+    out << node;
+    return std::string(out.c_str()) + "\n";
   }
 
   const SRNetworkImpl& parent_;

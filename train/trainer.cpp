@@ -21,6 +21,10 @@ config::Schema<TrainSchedule> schedule_schema() {
   s.field("patch_size", &TrainSchedule::patch_size, "LR patch side in pixels").range(4, 1024);
   s.field("lr_max", &TrainSchedule::lr_max, "learning rate at the start of the cosine schedule").range(1e-12, 100);
   s.field("lr_min", &TrainSchedule::lr_min, "learning rate at the end of the cosine schedule").range(0, 100);
+  s.field("rit_lr_scale", &TrainSchedule::rit_lr_scale,
+          "learning-rate factor of the rendering-information parts (RIT, HR branch, geometry head), which "
+          "start from scratch when the backbone is fine-tuned")
+      .range(1e-3, 1e3);
   s.field("clip_grad_norm", &TrainSchedule::clip_grad_norm, "gradient norm limit (0 = no clipping)").at_least(0);
   s.field("augment", &TrainSchedule::augment, "random flips and 90 degree rotations");
   s.field("validate_every", &TrainSchedule::validate_every, "steps between validations (0 = at the end)").at_least(0);
@@ -63,10 +67,25 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
 }
 
 namespace {
-std::vector<torch::Tensor> trainable(const SRNetworkImpl& net) {
-  std::vector<torch::Tensor> out;
-  for (const auto& p : net.parameters())
-    if (p.requires_grad()) out.push_back(p);
+// The trainable parameters: the backbone's, then the rendering-information parts' (RIT, HR
+// branch, geometry head), which may learn at another rate.
+struct TrainableParameters {
+  std::vector<torch::Tensor> backbone, rit;
+  std::vector<torch::Tensor> all() const {
+    std::vector<torch::Tensor> out = backbone;
+    out.insert(out.end(), rit.begin(), rit.end());
+    return out;
+  }
+};
+
+TrainableParameters trainable(const SRNetworkImpl& net) {
+  TrainableParameters out;
+  for (const auto& item : net.named_parameters()) {
+    if (!item.value().requires_grad()) continue;
+    const std::string& key = item.key();
+    const bool rit = key.rfind("rit.", 0) == 0 || key.rfind("geometry.", 0) == 0;
+    (rit ? out.rit : out.backbone).push_back(item.value());
+  }
   return out;
 }
 
@@ -278,10 +297,23 @@ bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, Trai
 }
 
 TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint, bool resume) {
-  auto params = trainable(*network_);
+  const TrainableParameters groups = trainable(*network_);
+  std::vector<torch::Tensor> params = groups.all(), extras;
   for (const auto& p : hooks_.extra_parameters)
-    if (p.requires_grad()) params.push_back(p);
-  optimizer_ = std::make_unique<torch::optim::Adam>(params, torch::optim::AdamOptions(schedule_.lr_max));
+    if (p.requires_grad()) extras.push_back(p);
+  params.insert(params.end(), extras.begin(), extras.end());
+  // One parameter group unless the rendering-information parts learn at their own rate (so that
+  // the checkpoints of single-group runs still load).
+  std::vector<torch::optim::OptimizerParamGroup> param_groups;
+  if (schedule_.rit_lr_scale != 1.0 && !groups.rit.empty()) {
+    std::vector<torch::Tensor> rest = groups.backbone;
+    rest.insert(rest.end(), extras.begin(), extras.end());
+    param_groups.emplace_back(rest);
+    param_groups.emplace_back(groups.rit);
+  } else {
+    param_groups.emplace_back(params);
+  }
+  optimizer_ = std::make_unique<torch::optim::Adam>(param_groups, torch::optim::AdamOptions(schedule_.lr_max));
   TrainOutcome outcome;
   int step = 0;
   NchwOnExit nchw_on_exit{*network_};
@@ -312,8 +344,9 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   const int first_step = step;
   while (step < schedule_.steps) {
     const double lr = learning_rate(step);
-    for (auto& group : optimizer_->param_groups())
-      static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+    for (size_t g = 0; g < optimizer_->param_groups().size(); ++g)
+      static_cast<torch::optim::AdamOptions&>(optimizer_->param_groups()[g].options())
+          .lr(g == 1 ? lr * schedule_.rit_lr_scale : lr);
 
     // Batches are a function of the step, so a resumed run sees the same data.
     const Batch batch = in_layout(sampler.batch(step), layout_);

@@ -31,6 +31,11 @@ struct TrainSchedule {
   int patch_size = 48;  // LR pixels; HR patches are scale x larger
   double lr_max = 1e-3;
   double lr_min = 1e-6;
+  // Learning-rate factor of the rendering-information parts (RIT, HR branch, geometry head).
+  // A CG-enhanced network fine-tunes a trained backbone while those parts start from scratch;
+  // Adam moves a weight by about the learning rate per step, so at a fine-tuning rate a
+  // zero-initialised fusion barely leaves zero in a short schedule.
+  double rit_lr_scale = 1.0;
   double clip_grad_norm = 1.0;  // 0 disables clipping
   bool augment = true;          // flips and 90 degree rotations
   int validate_every = 250;     // steps; 0 = only at the end

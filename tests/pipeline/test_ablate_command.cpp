@@ -61,5 +61,13 @@ TEST(Ablation, TrainsEveryVariantAgainstTheControlAndResumes) {
   EXPECT_EQ(rerun.at("rows"), rows);
   EXPECT_EQ(rerun.at("best_source"), best);
   EXPECT_NE((again.out + again.err).find("already done"), std::string::npos);
+  EXPECT_EQ((again.out + again.err).find("other settings"), std::string::npos);
+
+  // Changed settings are not mixed with the records of the old ones: every run trains again.
+  const auto changed = run_cgsr(command + " --set ablation.schedule.rit_lr_scale=10");
+  ASSERT_EQ(changed.exit_code, 0) << changed.err;
+  EXPECT_EQ((changed.out + changed.err).find("already done"), std::string::npos);
+  EXPECT_NE((changed.out + changed.err).find("plain (control) seed 1 was trained under other settings"),
+            std::string::npos);
   fs::remove_all(dir);
 }

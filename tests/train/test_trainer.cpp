@@ -71,3 +71,30 @@ TEST(Trainer, AutoLayoutRecordsItsChoice) {
   EXPECT_TRUE(outcome.layout == "nchw" || outcome.layout == "nhwc") << outcome.layout;
   for (const auto& p : net->parameters()) EXPECT_TRUE(p.is_contiguous());
 }
+
+// Adam's first step moves every weight with a gradient by the learning rate, so after one step
+// the largest change per part is that part's rate: the RIT's is rit_lr_scale times the backbone's.
+TEST(Trainer, RenderingInformationPartsLearnAtTheirOwnRate) {
+  set_threads(1);
+  seed_everything(3);
+  SRNetwork net(spec_from_yaml(
+      "backbone: pan\nscale: 2\nblocks: 2\nrit: {enabled: true, channels: [depth, edge], source: hr_fuse}\n", "test"));
+  std::vector<std::pair<std::string, torch::Tensor>> before;
+  for (const auto& item : net->named_parameters()) before.emplace_back(item.key(), item.value().detach().clone());
+  TrainSchedule schedule = short_schedule("nchw");
+  schedule.steps = 1;
+  schedule.lr_max = schedule.lr_min = 1e-3;
+  schedule.rit_lr_scale = 10;
+  const Dataset data = Dataset::open(tiny_data());
+  Trainer(net, data, schedule, LossOptions{}).run();
+
+  double backbone = 0, rit = 0;
+  const auto after = net->named_parameters();
+  for (const auto& [key, value] : before) {
+    const double moved = (after[key] - value).abs().max().item<double>();
+    double& part = key.rfind("rit.", 0) == 0 ? rit : backbone;
+    part = std::max(part, moved);
+  }
+  EXPECT_NEAR(backbone, 1e-3, 1e-5);
+  EXPECT_NEAR(rit, 1e-2, 1e-4);
+}
