@@ -13,7 +13,9 @@
 //     once per part and sums the parts in its output (sum post-op);
 //   - resizes (nearest, bilinear), average pooling, pixel shuffle and the remaining element-wise
 //     ops are oneDNN primitives; bicubic resizing goes through graph::apply_resize (LibTorch).
-// The result equals graph::run up to float rounding (different summation orders).
+// The result equals graph::run up to float rounding (different summation orders), for finite
+// input: oneDNN's fused ReLU turns NaN into 0 where LibTorch keeps it (data sets reject
+// non-finite frames when they load, so no data path feeds NaN).
 //
 //   FusedGraph fast(net->describe());         // snapshot of the weights
 //   auto sr = fast.run(lr_color);             // [N, 3, s*h, s*w], contiguous NCHW float32

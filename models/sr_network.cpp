@@ -30,6 +30,9 @@ void SRNetworkImpl::check_inputs(const torch::Tensor& lr_color, const torch::Ten
   if (!lr_color.defined() || lr_color.dim() != 4 || lr_color.size(1) != 3)
     throw Error(context, "colour input must be [N, 3, h, w], got " +
                              (lr_color.defined() ? shape_string(lr_color) : std::string("nothing")));
+  // LibTorch's own errors for these name a kernel or resize deep inside the backbone.
+  if (lr_color.numel() == 0)
+    throw Error(context, "colour input " + shape_string(lr_color) + " is empty: nothing to upscale");
   if (!has_rit()) return;
   const int64_t c = spec_.rit.info_width(), f = rit_->info_factor();
   const std::vector<int64_t> want = {lr_color.size(0), c, lr_color.size(2) * f, lr_color.size(3) * f};

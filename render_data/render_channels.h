@@ -6,7 +6,8 @@
 //
 //   name          width  range     meaning
 //   depth           1    [0,1]    depth in the encoding the consumer asks for (DepthEncoding below;
-//                                 0 at the near plane, 1 at the far plane and for sky)
+//                                 0 at the near plane (near/far for linear), 1 at the far
+//                                 plane and for sky)
 //   normal          3    [-1,1]   view-space unit normal (x right, y up, z towards the camera);
 //                                 0 where there is no geometry (sky)
 //   normal_angle    1    [0,1]    angle between the normal and the direction to the camera,
@@ -48,7 +49,8 @@ torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderC
 //   linear   z / far
 //   zbuffer  the z-buffer value (normalize_depth); above 0.95 for most of a scene with a near
 //            plane of a few centimetres, so it carries little signal (kept for older model files)
-// All clamp to [0,1]: 0 at (and before) the near plane, 1 at the far plane and beyond (sky).
+// All clamp to [0,1] and give 1 at the far plane and beyond (sky); log and zbuffer give 0 at (and
+// before) the near plane, linear gives near/far there.
 enum class DepthEncoding { Log, Linear, ZBuffer };
 DepthEncoding depth_encoding_from_name(const std::string& name);  // cgsr::Error listing valid names
 const char* depth_encoding_name(DepthEncoding encoding);

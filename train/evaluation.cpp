@@ -168,10 +168,12 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   bool warned_no_edges = false;
   for (int frame : frames) {
     const Batch b = frame_batch(data, frame, result.scale, channels, depth);
-    const auto sr = upscale_frame(b, frame).clamp(0.0, 1.0);
+    const auto raw = upscale_frame(b, frame);
     const auto details = upscaler.frame_details();
-    if (!torch::isfinite(sr).all().item<bool>())
+    // Checked before clamping, which would turn infinite values into 0 and 1.
+    if (!torch::isfinite(raw).all().item<bool>())
       throw Error(result.name + ": frame " + std::to_string(frame), "the upscaler produced NaN or infinite values");
+    const auto sr = raw.clamp(0.0, 1.0);
     FrameScore score;
     score.frame = frame;
     score.details = details;

@@ -370,7 +370,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
       if (++consecutive_bad >= schedule_.max_nonfinite_steps)
         throw Error("train", std::to_string(consecutive_bad) + " consecutive steps with a non-finite loss or gradient "
                              "at step " + std::to_string(step) + " (learning rate " + std::to_string(lr) +
-                             "); lower schedule.lr_max or raise clip_grad_norm");
+                             "); lower schedule.lr_max");
     }
     ++step;
     progress.set_status("loss " + std::to_string(terms.image).substr(0, 8) + " lr " + std::to_string(lr).substr(0, 8));
@@ -391,6 +391,13 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
     if (checkpoint && (step % schedule_.checkpoint_every == 0 || last)) save_checkpoint(*checkpoint, step, outcome);
   }
   progress.finish();
+  // A run can end before max_nonfinite_steps skipped steps in a row with weights whose outputs
+  // overflow (learning rate far too high): do not hand those back as its result.
+  if (!std::isfinite(outcome.best.image_loss) || !std::isfinite(outcome.best.geometry_loss))
+    throw Error("train", "the best validation (step " + std::to_string(outcome.best.step) +
+                             ") has a non-finite loss (image " + std::to_string(outcome.best.image_loss) +
+                             ", geometry " + std::to_string(outcome.best.geometry_loss) + ") after " +
+                             std::to_string(outcome.skipped_steps) + " skipped non-finite steps; lower schedule.lr_max");
   outcome.steps = step;
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   outcome.patches_per_second =

@@ -111,6 +111,41 @@ TEST(Evaluation, WithoutAnEdgeChannelTheEdgeFiguresStayEmpty) {
   EXPECT_FALSE(eval_result_from_json(j, "test").psnr_edge.has_value());
 }
 
+namespace {
+// Bicubic with one pixel replaced: an upscaler whose arithmetic overflowed (or went NaN).
+class BrokenUpscaler : public Upscaler {
+ public:
+  explicit BrokenUpscaler(float value) : value_(value) {}
+  std::string name() const override { return "broken"; }
+  int scale() const override { return 2; }
+  torch::Tensor upscale(const Batch& batch) override {
+    auto out = bicubic_->upscale(batch).clone();
+    out.index_put_({0, 1, 3, 4}, value_);
+    return out;
+  }
+
+ private:
+  float value_;
+  std::unique_ptr<Upscaler> bicubic_ = classic_upscalers().get("bicubic")(2);
+};
+}  // namespace
+
+// Infinite values are caught before clamping to [0,1] would hide them as 0 or 1.
+TEST(Evaluation, NonFiniteUpscalerOutputIsAnErrorNamingTheFrame) {
+  const Dataset data = Dataset::open(tiny_data());
+  for (const float value : {INFINITY, -INFINITY, NAN}) {
+    SCOPED_TRACE(value);
+    BrokenUpscaler upscaler(value);
+    try {
+      evaluate(upscaler, data, all_frames("2:3"));
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("broken: frame 2"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("NaN or infinite values"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Evaluation, JsonKeepsTheEdgeFigures) {
   const Dataset data = Dataset::open(tiny_data());
   auto upscaler = classic_upscalers().get("bicubic")(2);

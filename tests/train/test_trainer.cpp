@@ -1,8 +1,10 @@
 // The trainer on a tiny rendered scene: the memory layout of its steps changes results only
-// within float tolerance, the network comes back in NCHW, and the choice is recorded.
+// within float tolerance, the network comes back in NCHW, and the choice is recorded; steps with
+// a non-finite loss or gradient are skipped and counted, and a run that blows up stops with an error.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "core/error.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
 #include "tests/support/tiny_data.h"
@@ -97,4 +99,154 @@ TEST(Trainer, RenderingInformationPartsLearnAtTheirOwnRate) {
   }
   EXPECT_NEAR(backbone, 1e-3, 1e-5);
   EXPECT_NEAR(rit, 1e-2, 1e-4);
+}
+
+namespace {
+
+std::vector<torch::Tensor> weights_of(const SRNetwork& net) {
+  std::vector<torch::Tensor> out;
+  for (const auto& p : net->parameters()) out.push_back(p.detach().clone());
+  return out;
+}
+
+double largest_change(const std::vector<torch::Tensor>& a, const std::vector<torch::Tensor>& b) {
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, (a[i] - b[i]).abs().max().item<double>());
+  return worst;
+}
+
+bool all_finite(const std::vector<torch::Tensor>& weights) {
+  for (const auto& w : weights)
+    if (!torch::isfinite(w).all().item<bool>()) return false;
+  return true;
+}
+
+// A constant learning rate (no cosine decay), NCHW, `steps` steps.
+TrainSchedule constant_rate(double lr, int steps) {
+  TrainSchedule s = short_schedule("nchw");
+  s.steps = steps;
+  s.lr_max = s.lr_min = lr;
+  return s;
+}
+
+// Trains a fresh small PAN with an extra loss term `extra(step, network)` and returns the
+// weights each step started from (index = step) with the outcome.
+std::pair<std::vector<std::vector<torch::Tensor>>, TrainOutcome> train_with_extra_loss(
+    const TrainSchedule& schedule, const std::function<torch::Tensor(int, SRNetworkImpl&)>& extra) {
+  seed_everything(3);
+  SRNetwork net(small_pan());
+  std::vector<std::vector<torch::Tensor>> started_from;
+  TrainHooks hooks;
+  hooks.extra_loss = [&](const Batch&, const TrainOutput&, int step) {
+    EXPECT_EQ(static_cast<size_t>(step), started_from.size());
+    started_from.push_back(weights_of(net));
+    return extra(step, *net);
+  };
+  const Dataset data = Dataset::open(tiny_data());
+  TrainOutcome outcome = Trainer(net, data, schedule, LossOptions{}, {}, hooks).run();
+  return {started_from, outcome};
+}
+
+// The message of the cgsr::Error that `f` throws ("" and a test failure when it throws none).
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no cgsr::Error";
+  return "";
+}
+
+}  // namespace
+
+// Adam moves a weight by about the learning rate per step: at 10 the first step leaves weights
+// near 10, the outputs near 1e30, and every later gradient overflows. Those steps are skipped;
+// after max_nonfinite_steps of them in a row training stops, and a run that ends sooner stops
+// too, because its best validation loss is not finite. Both errors name lr_max, and the weights
+// stay finite (no non-finite step is applied).
+TEST(Trainer, LearningRateOfTenStopsTrainingWithAnErrorNamingLrMax) {
+  set_threads(1);
+  const Dataset data = Dataset::open(tiny_data());
+  for (const int max_nonfinite_steps : {3, 20}) {
+    SCOPED_TRACE(max_nonfinite_steps);
+    seed_everything(3);
+    SRNetwork net(small_pan());
+    TrainSchedule schedule = constant_rate(10, 8);
+    schedule.max_nonfinite_steps = max_nonfinite_steps;
+    const std::string what = error_of([&] { Trainer(net, data, schedule, LossOptions{}).run(); });
+    EXPECT_NE(what.find("lr_max"), std::string::npos) << what;
+    if (max_nonfinite_steps == 3)
+      EXPECT_NE(what.find("3 consecutive steps with a non-finite loss or gradient"), std::string::npos) << what;
+    else
+      EXPECT_NE(what.find("the best validation (step 8) has a non-finite loss"), std::string::npos) << what;
+    EXPECT_TRUE(all_finite(weights_of(net)));
+  }
+}
+
+TEST(Trainer, LearningRateOfOneBillionthBarelyMovesTheWeights) {
+  set_threads(1);
+  seed_everything(3);
+  SRNetwork net(small_pan());
+  const auto before = weights_of(net);
+  const Dataset data = Dataset::open(tiny_data());
+  Trainer trainer(net, data, constant_rate(1e-9, 3), LossOptions{});
+  const double untrained_psnr = trainer.validate(0).psnr;
+  const TrainOutcome outcome = trainer.run();
+  EXPECT_EQ(outcome.skipped_steps, 0);
+  const auto after = weights_of(net);
+  ASSERT_TRUE(all_finite(after));
+  // Three steps of about 1e-9 each (a float32 weight near 1 cannot even show one of them).
+  const double moved = largest_change(before, after);
+  EXPECT_GT(moved, 0.0);
+  EXPECT_LT(moved, 1e-7);
+  EXPECT_TRUE(std::isfinite(outcome.best.psnr));
+  EXPECT_NEAR(outcome.best.psnr, untrained_psnr, 1e-4);
+}
+
+// A NaN loss on step 2 (through the extra-loss hook): the step is skipped and counted, and the
+// next step starts from the weights step 2 started from; the steps around it train normally.
+TEST(Trainer, StepWithANonFiniteLossIsSkippedAndCounted) {
+  set_threads(1);
+  const auto [started_from, outcome] = train_with_extra_loss(constant_rate(1e-3, 5), [](int step, SRNetworkImpl&) {
+    return torch::full({}, step == 2 ? std::numeric_limits<float>::quiet_NaN() : 0.f);
+  });
+  EXPECT_EQ(outcome.steps, 5);
+  EXPECT_EQ(outcome.skipped_steps, 1);
+  ASSERT_EQ(started_from.size(), 5u);
+  EXPECT_EQ(largest_change(started_from[2], started_from[3]), 0.0);  // step 2 left every weight as it was
+  EXPECT_GT(largest_change(started_from[1], started_from[2]), 0.0);  // steps 1 and 3 moved them
+  EXPECT_GT(largest_change(started_from[3], started_from[4]), 0.0);
+  EXPECT_TRUE(std::isfinite(outcome.best.psnr));
+}
+
+// A finite loss whose gradient is NaN (d sqrt(u)/du at u = 0 is infinite, times du/dw = 0) is
+// caught by the gradient norm and skipped the same way.
+TEST(Trainer, StepWithANonFiniteGradientIsSkippedAndCounted) {
+  set_threads(1);
+  const auto [started_from, outcome] =
+      train_with_extra_loss(constant_rate(1e-3, 4), [](int step, SRNetworkImpl& net) {
+        const auto w = net.parameters().front();
+        return step == 1 ? torch::sqrt(w.sum() * 0) : torch::zeros({});
+      });
+  EXPECT_EQ(outcome.skipped_steps, 1);
+  ASSERT_EQ(started_from.size(), 4u);
+  EXPECT_EQ(largest_change(started_from[1], started_from[2]), 0.0);
+  EXPECT_GT(largest_change(started_from[2], started_from[3]), 0.0);
+  EXPECT_TRUE(all_finite(started_from[3]));
+}
+
+TEST(Trainer, ConsecutiveNonFiniteStepsStopTrainingWithAClearError) {
+  set_threads(1);
+  TrainSchedule schedule = constant_rate(1e-3, 6);
+  schedule.max_nonfinite_steps = 2;
+  try {
+    train_with_extra_loss(schedule, [](int, SRNetworkImpl&) { return torch::full({}, INFINITY); });
+    ADD_FAILURE() << "training did not stop";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("2 consecutive steps with a non-finite loss or gradient at step 1"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("lr_max"), std::string::npos) << what;
+  }
 }
