@@ -1,6 +1,8 @@
 // `cgsr run` end to end on the tiny scene with tiny schedules: every stage leaves its artifacts
 // and a finished-stage record, a rerun skips everything, `--from` and a changed stage config
 // rerun exactly the stages they should, and a stage's config error names the run config's key.
+// The CG-enhanced network reads HR rendering information through both HR sources, so search,
+// pruning, export and the report all handle the second input.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -22,7 +24,8 @@ train:
   schedule: {steps: 6, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, checkpoint_every: 3}
 enhance:
   name: CG-enhanced PAN x2
-  enhance: {rit: {channels: [depth, normal_angle, edge], width: 8}, geometry: {enabled: true, width: 8}}
+  enhance: {rit: {channels: [depth, normal_angle, edge], width: 8, hr_width: 8, source: hr_unshuffle+hr_fuse},
+            geometry: {enabled: true, width: 8}}
   schedule: {steps: 4, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 search:
   name: CG-optimized PAN x2
