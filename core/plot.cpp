@@ -45,7 +45,8 @@ std::vector<double> ticks(double lo, double hi, bool log_scale) {
       step = m * magnitude;
       break;
     }
-  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-12; v += step) out.push_back(v);
+  // Multiples of the step, so that 0 is exactly 0 (not the residue of repeated additions).
+  for (double k = std::ceil(lo / step); k * step <= hi + 1e-12; k += 1) out.push_back(k * step);
   return out;
 }
 }  // namespace
@@ -141,8 +142,12 @@ void write_bar_chart(const std::filesystem::path& path, const BarChart& chart) {
   const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5, y_lo = lo - margin, y_hi = hi + margin;
 
   const int group = std::max(60, 22 * static_cast<int>(chart.series.size()) + 24);
-  const int left = 80, right = 220, top = 50, bottom = 150;
-  const int width = left + right + group * static_cast<int>(chart.categories.size()), height = 560;
+  // Room below the axis for the longest category name, written downwards.
+  int longest = 0;
+  for (const auto& name : chart.categories)
+    longest = std::max(longest, cv::getTextSize(name, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, nullptr).width);
+  const int left = 80, right = 220, top = 50, bottom = std::max(150, longest + 24);
+  const int width = left + right + group * static_cast<int>(chart.categories.size()), height = 410 + bottom;
   auto py = [&](double y) { return static_cast<int>(height - bottom - (y - y_lo) / (y_hi - y_lo) * (height - top - bottom)); };
 
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
