@@ -107,6 +107,7 @@ class Runner {
       const AblationRun r = run_once(v, seed);
       row.params = r.params;
       row.macs = r.macs;
+      row.seeds.push_back(seed);
       row.psnr.push_back(r.eval.psnr);
       row.val_psnr.push_back(r.val_psnr);
       if (r.eval.psnr_edge) row.psnr_edge.push_back(*r.eval.psnr_edge);
@@ -280,7 +281,7 @@ std::string ablation_csv(const AblationResult& result) {
   csv << "variant,kind,seed,params,macs,val_psnr,psnr,psnr_edge,psnr_rest\n";
   for (const auto& row : result.rows)
     for (size_t i = 0; i < row.psnr.size(); ++i)
-      csv << row.variant.name << "," << row.variant.kind << "," << i << "," << row.params << "," << row.macs << ","
+      csv << row.variant.name << "," << row.variant.kind << "," << row.seeds.at(i) << "," << row.params << "," << row.macs << ","
           << fixed(row.val_psnr[i], 4) << "," << fixed(row.psnr[i], 4) << ","
           << (i < row.psnr_edge.size() ? fixed(row.psnr_edge[i], 4) : "") << ","
           << (i < row.psnr_rest.size() ? fixed(row.psnr_rest[i], 4) : "") << "\n";
@@ -319,6 +320,7 @@ nlohmann::ordered_json to_json(const AblationResult& result) {
                          {"spec", spec_summary(row.variant.spec)},
                          {"params", row.params},
                          {"macs", row.macs},
+                         {"seeds", row.seeds},
                          {"val_psnr", row.val_psnr},
                          {"psnr", row.psnr},
                          {"psnr_edge", row.psnr_edge},

@@ -66,6 +66,7 @@ struct AblationRun {
 struct AblationRow {
   AblationVariant variant;
   int64_t params = 0, macs = 0;
+  std::vector<int64_t> seeds;                                // the seeds of the per-seed figures
   std::vector<double> psnr, psnr_edge, psnr_rest, val_psnr;  // one per seed
 };
 

@@ -38,6 +38,7 @@ TEST(Ablation, TrainsEveryVariantAgainstTheControlAndResumes) {
   EXPECT_EQ(rows[3].at("variant"), best + " - depth");
   EXPECT_EQ(rows[6].at("variant"), "small + " + best);
   for (const auto& row : rows) {
+    EXPECT_EQ(row.at("seeds"), nlohmann::json::array({1, 2})) << row;
     EXPECT_EQ(row.at("psnr").size(), 2u) << row;  // one per seed
     EXPECT_EQ(row.at("psnr_edge").size(), 2u) << row;
   }
@@ -52,7 +53,9 @@ TEST(Ablation, TrainsEveryVariantAgainstTheControlAndResumes) {
   EXPECT_NE(md.find("| plain (control) |"), std::string::npos) << md;
   EXPECT_NE(md.find("closes"), std::string::npos) << md;
   EXPECT_TRUE(fs::exists(dir / "run" / "ablation.png"));
-  EXPECT_TRUE(fs::exists(dir / "run" / "ablation.csv"));
+  // The CSV has one line per (variant, seed), naming the seed.
+  const std::string csv = read_file(dir / "run" / "ablation.csv");
+  EXPECT_NE(csv.find("\nplain (control),control,2,"), std::string::npos) << csv;
 
   // A rerun trains nothing: every (variant, seed) has its record.
   const auto again = run_cgsr(command);
