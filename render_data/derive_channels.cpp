@@ -88,14 +88,17 @@ void derive_channels(Frame& f, const std::vector<RenderChannel>& derive, double 
   if (!any) return;
   if (!f.depth.defined()) throw Error("derive channels", "deriving channels needs depth, which the frame does not have");
   torch::Tensor normal = f.normal.defined() ? f.normal.to(torch::kFloat32) : torch::Tensor();
+  // Creases come from stored normals, or from normals derived from exact depth: normals of a
+  // quantised depth staircase turn at every step.
+  torch::Tensor crease_normal = normal;
   if (wanted(RenderChannel::Normal) || (wanted(RenderChannel::NormalAngle) && !normal.defined())) {
     normal = normals_from_depth(f.depth, vfov);
     if (wanted(RenderChannel::Normal)) f.normal = normal.to(torch::kFloat16);
+    if (wanted(RenderChannel::Normal) && f.depth_precision.exact()) crease_normal = normal;
   }
   if (wanted(RenderChannel::NormalAngle)) f.normal_angle = normal_angle_from_normals(normal, vfov).to(torch::kFloat16);
   if (wanted(RenderChannel::Edge))
-    f.edge = detect_edges(f.depth, f.normal.defined() ? f.normal.to(torch::kFloat32) : torch::Tensor(), {}, edges)
-                 .to(torch::kUInt8);
+    f.edge = detect_edges(f.depth, crease_normal, {}, edges, f.depth_precision).to(torch::kUInt8);
 }
 
 }  // namespace cgsr

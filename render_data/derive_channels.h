@@ -6,7 +6,8 @@
 //                 change (so they do not straddle a silhouette); n = normalize(tangent_y x
 //                 tangent_x), turned to face the camera. Pixels without geometry get 0.
 //   normal angle  angle between that normal and the direction to the camera / 90 degrees.
-//   edges         edges.h on depth (and normals when present).
+//   edges         edges.h on depth (at its stored precision) and normals when present (derived
+//                 ones only from exact depth).
 
 #include <torch/types.h>
 

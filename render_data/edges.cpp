@@ -18,6 +18,7 @@ struct EdgeInput {
   const float* n = nullptr;       // 3 planes or null
   const int32_t* id = nullptr;    // or null
   float depth_threshold = 0, cos_crease = -2;
+  DepthPrecision precision;
 };
 
 // Discontinuity between p = (y, x) and its neighbour q = p + (dy, dx) (dx, dy >= 0 pairs only,
@@ -44,14 +45,17 @@ bool discontinuous(const EdgeInput& in, int y, int x, int dy, int dx) {
     const float wa = in.w[static_cast<size_t>(ay) * in.W + ax];
     if (wa > 0) pred_p = 2 * wq - wa;
   }
-  const float tolerance = in.depth_threshold * std::max(wp, wq);
+  // Quantisation: w_q - (2 w_p - w_b) takes each value's storage error (under a step, rounded
+  // or truncated) once, the middle one twice with the opposite sign, so it stays within 2 steps.
+  const float w = std::max(wp, wq);
+  const float tolerance = in.depth_threshold * w + static_cast<float>(2.01 * in.precision.step_at(w));
   return std::abs(wq - pred_q) > tolerance && std::abs(wp - pred_p) > tolerance;
 }
 
 }  // namespace
 
 torch::Tensor detect_edges(const torch::Tensor& depth, const torch::Tensor& normal, const torch::Tensor& ids,
-                           const EdgeSettings& settings) {
+                           const EdgeSettings& settings, const DepthPrecision& precision) {
   const auto d = depth.dim() == 3 ? depth.squeeze(0) : depth;
   CGSR_CHECK(d.dim() == 2, "detect_edges needs an [H,W] depth map");
   const int H = static_cast<int>(d.size(0)), W = static_cast<int>(d.size(1));
@@ -65,6 +69,7 @@ torch::Tensor detect_edges(const torch::Tensor& depth, const torch::Tensor& norm
   in.H = H;
   in.w = inv.data_ptr<float>();
   in.depth_threshold = settings.depth_threshold;
+  in.precision = precision;
   if (normal.defined()) {
     n = normal.to(torch::kFloat32).reshape({3, H, W}).contiguous();
     in.n = n.data_ptr<float>();

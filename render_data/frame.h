@@ -9,6 +9,7 @@
 
 #include <vector>
 
+#include "render_data/edges.h"
 #include "render_data/gbuffer.h"
 #include "render_data/render_channels.h"
 
@@ -22,6 +23,7 @@ struct Frame {
   torch::Tensor normal_angle;  // float16 [1,H,W] in [0,1]
   torch::Tensor edge;          // uint8 [1,H,W], 0 or 1
   torch::Tensor motion;        // float32 [2,H,W], pixels (render_channels.h)
+  DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
 
   bool has(RenderChannel channel) const;
   std::vector<RenderChannel> channels() const;  // present channels, in the fixed order
