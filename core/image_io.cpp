@@ -71,6 +71,10 @@ cv::Mat to_mat(const torch::Tensor& image, int bits, const std::string& context)
 }  // namespace
 
 torch::Tensor read_image(const fs::path& path, const ImageReadOptions& options) {
+  return read_image_file(path, options).pixels;
+}
+
+ImageFile read_image_file(const fs::path& path, const ImageReadOptions& options) {
   enable_exr();
   const std::string context = path.string();
   if (!fs::exists(path)) throw Error(context, "no such image file");
@@ -84,17 +88,19 @@ torch::Tensor read_image(const fs::path& path, const ImageReadOptions& options) 
   if (c == 4) cv::cvtColor(mat, mat, cv::COLOR_BGRA2RGBA);
 
   cv::Mat as_float;
+  ImageFile out;
   switch (mat.depth()) {
-    case CV_8U: mat.convertTo(as_float, CV_32F, 1.0 / 255.0); break;
-    case CV_16U: mat.convertTo(as_float, CV_32F, 1.0 / 65535.0); break;
-    case CV_32F: as_float = mat; break;
+    case CV_8U: mat.convertTo(as_float, CV_32F, 1.0 / 255.0), out.bits = 8; break;
+    case CV_16U: mat.convertTo(as_float, CV_32F, 1.0 / 65535.0), out.bits = 16; break;
+    case CV_32F: as_float = mat, out.bits = 32; break;
     default: throw Error(context, "unsupported bit depth (expected 8-bit, 16-bit or 32-bit float)");
   }
   as_float = as_float.isContinuous() ? as_float : as_float.clone();
   auto hwc = torch::from_blob(as_float.data, {as_float.rows, as_float.cols, c}, torch::kFloat32);
   // clone(): for one channel the permuted view is already "contiguous", and contiguous() would
   // return a view of the cv::Mat's memory, which is freed on return.
-  return hwc.permute({2, 0, 1}).clone(at::MemoryFormat::Contiguous);
+  out.pixels = hwc.permute({2, 0, 1}).clone(at::MemoryFormat::Contiguous);
+  return out;
 }
 
 std::vector<unsigned char> encode_image(const std::string& extension, const torch::Tensor& image,

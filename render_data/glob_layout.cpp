@@ -28,11 +28,16 @@ config::Schema<GlobLayoutOptions> glob_layout_schema() {
   s.field("near", &GlobLayoutOptions::near_plane, "near plane of the depth").range(1e-9, 1e12);
   s.field("far", &GlobLayoutOptions::far_plane, "far plane of the depth").range(1e-9, 1e30);
   s.field("vfov", &GlobLayoutOptions::vfov, "vertical field of view, degrees").range(1, 179);
-  s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored").one_of({"normalized", "linear"});
+  s.field("color_alpha", &GlobLayoutOptions::color_alpha, "what the alpha of RGBA colour means").one_of(color_alpha_names());
+  s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored").one_of(capture_depth_names());
+  s.field("depth_scale", &GlobLayoutOptions::depth_scale, "linear depth: metres per stored unit").range(1e-12, 1e12);
+  s.section("motion_format", &GlobLayoutOptions::motion_format, motion_format_schema(), "how motion images map to pixels");
   s.list("resolutions", &GlobLayoutOptions::resolutions, r, "one entry per resolution");
   s.validate([](const GlobLayoutOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (o.resolutions.empty()) at.child("resolutions").fail(node, "needs at least one resolution");
     if (!(o.far_plane > o.near_plane)) at.child("far").fail(node, "far must be larger than near");
+    if (o.depth_scale != 1 && o.depth_encoding != "linear")
+      at.child("depth_scale").fail(node["depth_scale"], "applies to depth_encoding: linear only");
   });
   return s;
 }
@@ -112,7 +117,9 @@ class GlobDataset : public FrameSource {
   GlobDataset(const fs::path& yaml, const DatasetOpenOptions& options) {
     const auto doc = config::Document::load_file(yaml);
     const auto o = config::parse_document(doc, glob_layout_schema());
-    linear_depth_ = o.depth_encoding == "linear";
+    color_alpha_ = color_alpha_from_name(o.color_alpha);
+    motion_format_ = o.motion_format;
+    motion_format_.declared = static_cast<bool>(doc.root()["motion_format"]);
     const fs::path base = yaml.parent_path();
     info_.name = o.name.empty() ? yaml.stem().string() : o.name;
     info_.layout = "glob";
@@ -120,6 +127,10 @@ class GlobDataset : public FrameSource {
     info_.near_plane = options.near_plane > 0 ? options.near_plane : o.near_plane;
     info_.far_plane = options.far_plane > 0 ? options.far_plane : o.far_plane;
     info_.vfov = options.vfov > 0 ? options.vfov : o.vfov;
+    depth_format_.encoding = capture_depth_from_name(o.depth_encoding);
+    depth_format_.near_plane = info_.near_plane;
+    depth_format_.far_plane = info_.far_plane;
+    depth_format_.scale = o.depth_scale;
     size_t count = 0;
     std::string count_from;
     std::vector<bool> present(all_render_channels().size(), false);
@@ -176,51 +187,53 @@ class GlobDataset : public FrameSource {
   Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {
     const ResolutionFiles& rf = res_.at(res);
     const Resolution& r = rf.size;
+    // Reads one file, checked for size and NaN/Inf, and decodes it; errors name file and frame.
+    auto decode = [&](const fs::path& p, const char* what, auto&& decoder) {
+      try {
+        const ImageFile image = read_image_file(p);
+        check_image_size(image.pixels, r, p.string(), frame);
+        check_finite(image.pixels, p.string(), frame, what);
+        return decoder(image);
+      } catch (const Error& e) {
+        const std::string at = "frame " + std::to_string(frame) + ": ";
+        if (e.context() == p.string() && e.message().rfind(at, 0) == 0) throw;  // already says both
+        throw Error(p.string(), at + e.message(), e.kind());
+      }
+    };
+    auto file = [&](RenderChannel c) -> const fs::path& { return rf.files[static_cast<size_t>(c)].at(frame); };
+    auto first = [](int ch) {
+      return [ch](const ImageFile& image) {
+        if (image.pixels.size(0) < ch)
+          throw Error("image", "has " + std::to_string(image.pixels.size(0)) + " channel(s), expected at least " +
+                                   std::to_string(ch));
+        return image.pixels.slice(0, 0, ch).contiguous();
+      };
+    };
     Frame f;
     f.width = r.width;
     f.height = r.height;
-    f.color = read_color_file(rf.color.at(frame), frame, r);
-    auto read = [&](RenderChannel c, int ch) {
-      const fs::path& p = rf.files[static_cast<size_t>(c)].at(frame);
-      torch::Tensor v;
-      try {
-        v = read_image(p);
-      } catch (const Error& e) {
-        throw Error(p.string(), "frame " + std::to_string(frame) + ": " + e.message(), e.kind());
-      }
-      check_image_size(v, r, p.string(), frame);
-      if (v.size(0) < ch)
-        throw Error(p.string(), "frame " + std::to_string(frame) + ": has " + std::to_string(v.size(0)) +
-                                    " channel(s), expected at least " + std::to_string(ch));
-      check_finite(v, p.string(), frame, channel_name(c).c_str());
-      return std::make_pair(v.slice(0, 0, ch).contiguous(), p.string());
-    };
-    torch::Tensor depth;
-    for (auto c : channels) {
-      if (c == RenderChannel::Depth) {
-        auto [v, path] = read(c, 1);
-        if (linear_depth_) {
-          if ((v < 0).any().item<bool>()) throw Error(path, "frame " + std::to_string(frame) + ": negative depth");
-          depth = torch::where(v == 0, torch::full({}, std::numeric_limits<float>::infinity()), v);
-        } else {
-          depth = linearize_depth(v, info_.near_plane, info_.far_plane);
-        }
-        f.depth = depth;
-      }
+    f.color = decode(rf.color.at(frame), "color", [&](const ImageFile& image) { return decode_capture_color(image, color_alpha_); });
+    const bool has_depth = std::find(channels.begin(), channels.end(), RenderChannel::Depth) != channels.end();
+    if (has_depth) {
+      const auto map = decode(file(RenderChannel::Depth), "depth",
+                              [&](const ImageFile& image) { return decode_capture_depth(image, depth_format_); });
+      f.depth = map.depth;
+      f.depth_precision = map.precision;
     }
     for (auto c : channels) {
       switch (c) {
         case RenderChannel::Depth: break;
         case RenderChannel::Normal: {
-          auto [v, path] = read(c, 3);
-          auto n = v * 2 - 1;
-          if (depth.defined()) check_unit_normals(n, depth, path, frame);
+          const auto n = decode(file(c), "normal", first(3)) * 2 - 1;
+          if (f.depth.defined()) check_unit_normals(n, f.depth, file(c).string(), frame);
           f.normal = n.to(torch::kFloat16);
           break;
         }
-        case RenderChannel::NormalAngle: f.normal_angle = read(c, 1).first.to(torch::kFloat16); break;
-        case RenderChannel::Edge: f.edge = (read(c, 1).first > 0.5f).to(torch::kUInt8); break;
-        case RenderChannel::Motion: f.motion = read(c, 2).first; break;
+        case RenderChannel::NormalAngle: f.normal_angle = decode(file(c), "normal_angle", first(1)).to(torch::kFloat16); break;
+        case RenderChannel::Edge: f.edge = (decode(file(c), "edge", first(1)) > 0.5f).to(torch::kUInt8); break;
+        case RenderChannel::Motion:
+          f.motion = decode(file(c), "motion", [&](const ImageFile& image) { return decode_capture_motion(image, motion_format_); });
+          break;
       }
     }
     return f;
@@ -229,7 +242,9 @@ class GlobDataset : public FrameSource {
  private:
   DatasetInfo info_;
   std::vector<ResolutionFiles> res_;
-  bool linear_depth_ = false;
+  ColorAlpha color_alpha_ = ColorAlpha::Ignore;
+  DepthFormat depth_format_;
+  MotionFormat motion_format_;
 };
 
 fs::path glob_yaml(const fs::path& path) { return fs::is_directory(path) ? path / "dataset.yaml" : path; }

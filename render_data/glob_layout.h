@@ -9,18 +9,23 @@
 //   near: 0.1                   # planes of the capture's depth
 //   far: 1000
 //   vfov: 60                    # vertical field of view (for derived normals)
-//   depth_encoding: normalized  # normalized: z-buffer values in [0,1] (8/16-bit images), as
-//                               #   normalize_depth; linear: view depth in metres (float EXR/TIFF,
-//                               #   0 or inf = no geometry)
+//   color_alpha: ignore         # RGBA colour: ignore (drop alpha) or premultiplied
+//   depth_encoding: normalized  # normalized, reversed, linear (x depth_scale) or linear_normalized
+//   depth_scale: 1              # linear only: metres per stored unit (integer code or float)
+//   motion_format:              # how motion images map to pixels (default: float (dx, dy))
+//     x: {channels: [0, 1], scale: 2, offset: 0.5}   # [high, low] channels of a 16-bit code
+//     y: {channels: [2, 3], scale: -2, offset: 0.5}
+//     units: uv                 # pixels, or fractions of the frame's width and height
 //   resolutions:
 //     - size: 640x360
 //       color: lr/color_*.png
 //       depth: lr/depth_*.png
-//       motion: lr/mv_*.exr     # first two channels: (dx, dy) in pixels, render_channels.h sign
+//       motion: lr/mv_*.png
 //     - size: 1280x720
 //       color: hr/frame_*.png
 //
-// Patterns are relative to the YAML file; wildcards (* and ?) only in the file name part.
+// Patterns are relative to the YAML file; wildcards (* and ?) only in the file name part. The
+// encodings are capture_format.h's; docs/captures.md walks through a real capture.
 // Other channels: normal ((n + 1) / 2 in an RGB image), normal_angle (grey), edge (grey, 0/1).
 
 #include <filesystem>
@@ -28,6 +33,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "render_data/capture_format.h"
 
 namespace cgsr {
 
@@ -40,7 +46,10 @@ struct GlobLayoutOptions {
   std::string layout = "glob";
   std::string name;
   double near_plane = 0.1, far_plane = 1000, vfov = 60;
+  std::string color_alpha = "ignore";
   std::string depth_encoding = "normalized";
+  double depth_scale = 1;
+  MotionFormat motion_format;
   std::vector<GlobResolution> resolutions;
 };
 

@@ -24,6 +24,18 @@ torch::Tensor require(const torch::Tensor& t, const char* name) {
   if (!t.defined()) throw Error("preview", std::string("the frame has no '") + name + "' channel");
   return t;
 }
+
+bool shows(const Frame& f, PreviewChannel channel) {
+  switch (channel) {
+    case PreviewChannel::Color: return f.color.defined();
+    case PreviewChannel::Depth: return f.has(RenderChannel::Depth);
+    case PreviewChannel::Normal: return f.has(RenderChannel::Normal);
+    case PreviewChannel::NormalAngle: return f.has(RenderChannel::NormalAngle);
+    case PreviewChannel::Edge: return f.has(RenderChannel::Edge);
+    case PreviewChannel::Motion: return f.has(RenderChannel::Motion);
+  }
+  return false;
+}
 }  // namespace
 
 torch::Tensor visualize(const Frame& f, PreviewChannel channel, double motion_scale) {
@@ -70,13 +82,21 @@ torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<Previe
   const int W = hr.width, H = hr.height;
   auto canvas = torch::ones({3, static_cast<int64_t>(channels.size()) * (H + gap) - gap, 2 * W + gap});
   for (size_t row = 0; row < channels.size(); ++row) {
-    // Motion is in pixels of its own resolution: scale the LR colour wheel like the HR one.
-    const auto a = visualize(lr, channels[row], 8.0 / s);
-    const auto b = visualize(hr, channels[row], 8.0);
-    const auto big = a.repeat_interleave(s, 1).repeat_interleave(s, 2);
+    // A capture may hold a channel at one resolution only: the other cell stays black.
+    if (!shows(lr, channels[row]) && !shows(hr, channels[row]))
+      throw Error("preview", "neither resolution has the '" + preview_channel_names()[static_cast<size_t>(channels[row])] +
+                                 "' channel");
     const int64_t y = static_cast<int64_t>(row) * (H + gap);
-    canvas.slice(1, y, y + H).slice(2, 0, W).copy_(big);
-    canvas.slice(1, y, y + H).slice(2, W + gap, 2 * W + gap).copy_(b);
+    auto cells = canvas.slice(1, y, y + H);
+    // Motion is in pixels of its own resolution: scale the LR colour wheel like the HR one.
+    if (shows(lr, channels[row]))
+      cells.slice(2, 0, W).copy_(visualize(lr, channels[row], 8.0 / s).repeat_interleave(s, 1).repeat_interleave(s, 2));
+    else
+      cells.slice(2, 0, W).zero_();
+    if (shows(hr, channels[row]))
+      cells.slice(2, W + gap, 2 * W + gap).copy_(visualize(hr, channels[row], 8.0));
+    else
+      cells.slice(2, W + gap, 2 * W + gap).zero_();
   }
   return canvas;
 }

@@ -21,7 +21,8 @@ PreviewChannel preview_channel_from_name(const std::string& name);
 torch::Tensor visualize(const Frame& frame, PreviewChannel channel, double motion_scale = 8.0);
 
 // Rows = channels; columns = LR enlarged to the HR size by pixel replication, then HR. A 4-pixel
-// gap separates cells. Requires hr = s x lr for an integer s.
+// gap separates cells; a channel one resolution lacks leaves its cell black. Requires hr = s x lr
+// for an integer s.
 torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels);
 
 }  // namespace cgsr

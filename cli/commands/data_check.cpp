@@ -33,6 +33,13 @@ void setup_data_check(CLI::App& data) {
             "dir", [&flags](const std::string& v) { flags.push_back({"dir=" + v, "DIR " + v}); },
             "dataset directory or glob-layout YAML file");
         flag_to_key(sub, flags, "--layout", "open.layout", "dataset layout (auto, cgsr, cgsr-release, glob)");
+        sub.add_option_function<std::vector<std::string>>(
+               "--derive",
+               [&flags](const std::vector<std::string>& channels) {
+                 flags.push_back({"open.derive=[" + join(channels) + "]", "--derive"});
+               },
+               "channels to derive from depth when the data lacks them (edge, normal, normal_angle)")
+            ->delimiter(',');
         switch_to_key(sub, flags, "--clean-grid-lines", "open.clean_grid_lines", "remove CGSR tile-grid lines from edges");
         switch_to_key(sub, flags, "--json", "json", "print the report as JSON");
       },

@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include <fstream>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -86,6 +87,32 @@ TEST(GlobLayout, MismatchedCountsNameThePatterns) {
     const std::string what = e.what();
     EXPECT_NE(what.find("hr/frame*.png"), std::string::npos) << what;
     EXPECT_NE(what.find("matches 3 files"), std::string::npos) << what;
+  }
+}
+
+// RGBA colour loads (alpha dropped by default); colour the contract cannot hold is an error that
+// names the file and the frame.
+TEST(GlobLayout, RgbaColourLoadsAndHdrColourIsRejectedByFileAndFrame) {
+  const fs::path root = write_capture("glob_rgba", 3);
+  const auto rgb = torch::rand({3, 24, 32});
+  write_image(root / "lr" / "color_1.png", torch::cat({rgb, torch::full({1, 24, 32}, 0.5f)}, 0));
+  const Dataset data = Dataset::open(root);
+  EXPECT_TRUE(torch::equal(data.frame(1, 0)->color, (rgb * 255).round().to(torch::kUInt8)));
+  write_image(root / "lr" / "color_2.exr", torch::full({3, 24, 32}, 3.0f), {32});
+  fs::remove(root / "lr" / "color_2.png");
+  std::stringstream text;
+  text << std::ifstream(root / "dataset.yaml").rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("lr/color_*.png"), 14, "lr/color_*.*");
+  std::ofstream(root / "dataset.yaml") << yaml;
+  try {
+    Dataset::open(root).load(2, 0);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("color_2.exr"), std::string::npos) << what;
+    EXPECT_NE(what.find("frame 2"), std::string::npos) << what;
+    EXPECT_NE(what.find("display-referred"), std::string::npos) << what;
   }
 }
 
