@@ -80,13 +80,21 @@ std::vector<RenderChannel> with_motion(std::vector<RenderChannel> channels) {
   return channels;
 }
 
-torch::Tensor hr_motion(const Batch& b) {
+bool carries(const Dataset& data, size_t resolution, RenderChannel channel) {
+  const auto& here = channels_at(data.info(), resolution);
+  return std::find(here.begin(), here.end(), channel) != here.end();
+}
+
+// Motion vectors at HR for the temporal error: the batch's own, or, for captures that store them
+// at the render (LR) size only, the LR ones repeated over each s x s block and scaled by s.
+torch::Tensor hr_motion(const Batch& b, const Dataset& data, int frame, size_t lr_resolution, int scale) {
   int offset = 0;
   for (auto c : b.channels) {
     if (c == RenderChannel::Motion) return b.hr_info.slice(1, offset, offset + channel_width(c));
     offset += channel_width(c);
   }
-  throw Error("evaluation", "the batch has no motion vectors", ErrorKind::Internal);
+  const auto lr = data.frame(frame, lr_resolution)->motion.unsqueeze(0);
+  return lr.repeat_interleave(scale, 2).repeat_interleave(scale, 3) * static_cast<float>(scale);
 }
 
 // The HR edge map of `frame` at the size of `hr_color` (the batch's HR frame, from the cache),
@@ -94,9 +102,7 @@ torch::Tensor hr_motion(const Batch& b) {
 torch::Tensor hr_edges(const Dataset& data, int frame, const torch::Tensor& hr_color) {
   const size_t resolution =
       data.resolution_index({static_cast<int>(hr_color.size(-1)), static_cast<int>(hr_color.size(-2))});
-  const auto& here = channels_at(data.info(), resolution);
-  if (std::find(here.begin(), here.end(), RenderChannel::Edge) == here.end()) return {};
-  return data.frame(frame, resolution)->edge;
+  return carries(data, resolution, RenderChannel::Edge) ? data.frame(frame, resolution)->edge : torch::Tensor();
 }
 
 // Mean of a per-frame PSNR over the frames that have one, infinite ones (no error) left out as
@@ -132,18 +138,19 @@ std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::option
 }
 }  // namespace
 
-EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options) {
+EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options,
+                    const std::function<void(const EvalResult&)>& on_quality) {
   EvalResult result;
   result.name = upscaler.name();
   result.dataset = data.info().name;
   result.split = options.split;
   result.scale = upscaler.scale();
-  const auto& available = data.info().channels;
-  const bool temporal =
-      options.temporal && std::find(available.begin(), available.end(), RenderChannel::Motion) != available.end();
+  const auto [lr_resolution, hr_resolution] = resolution_pair(data, result.scale);
+  const bool hr_has_motion = carries(data, hr_resolution, RenderChannel::Motion);
+  const bool temporal = options.temporal && (hr_has_motion || carries(data, lr_resolution, RenderChannel::Motion));
   if (options.temporal && !temporal)
     spdlog::warn("{}: no motion vectors, temporal error skipped", data.info().root.string());
-  const auto channels = temporal ? with_motion(upscaler.channels()) : upscaler.channels();
+  const auto channels = temporal && hr_has_motion ? with_motion(upscaler.channels()) : upscaler.channels();
   const DepthEncoding depth = upscaler.depth_encoding();
   QualityOptions quality;
   quality.crop_border = options.crop_border;
@@ -200,7 +207,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
       const bool consecutive = last_frame == frame - 1;
       const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels, depth);
       const auto prev_sr = consecutive ? last_sr : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
-      const auto motion = hr_motion(b);
+      const auto motion = hr_motion(b, data, frame, lr_resolution, result.scale);
       score.temporal_error = warping_error(sr, prev_sr, motion);
       score.temporal_error_reference = warping_error(b.hr_color, prev.hr_color, motion);
     }
@@ -233,6 +240,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   result.lr_width = first.lr_color.size(3);
   result.lr_height = first.lr_color.size(2);
   result.cost = upscaler.cost(result.lr_width, result.lr_height);
+  if (on_quality) on_quality(result);
   if (options.latency_runs > 0) {
     constexpr int kWarmup = 2;
     Progress timing("latency " + result.name, kWarmup + options.latency_runs);

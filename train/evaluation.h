@@ -6,6 +6,7 @@
 // vectors, next to the same figure for the ground truth), and latency at the frame size.
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -65,7 +66,10 @@ struct EvalResult {
   std::optional<Complexity> cost;
 };
 
-EvalResult evaluate(Upscaler& upscaler, const Dataset& dataset, const EvalOptions& options);
+// `on_quality` is called once the quality figures are known, before the latency is measured
+// (which can take minutes at 1080p), so callers can write them out early.
+EvalResult evaluate(Upscaler& upscaler, const Dataset& dataset, const EvalOptions& options,
+                    const std::function<void(const EvalResult&)>& on_quality = {});
 
 nlohmann::ordered_json to_json(const EvalResult& result);
 EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::string& context);

@@ -106,10 +106,18 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   nlohmann::ordered_json json;
   json["data"] = data.info().root.string();
   json["evaluations"] = nlohmann::ordered_json::array();
+  // Each model's figures are written as soon as its quality is known: at 1080p the latency of the
+  // next models can take many minutes.
+  const auto write_results = [&](const EvalResult& r) {
+    if (!run_dir) return;
+    write_file_atomic(run_dir->file("frames_" + r.name + ".csv"), frames_csv(r));
+    std::vector<EvalResult> so_far = results;
+    so_far.push_back(r);
+    write_file_atomic(run_dir->file("summary.csv"), report_csv(group_results(so_far)));
+  };
   for (auto& upscaler : upscalers) {
-    EvalResult r = evaluate(*upscaler, data, options.eval);
+    EvalResult r = evaluate(*upscaler, data, options.eval, write_results);
     if (r.latency) spdlog::info("{}: latency {:.2f} ms (median of {})", r.name, r.latency->median_ms, r.latency->runs);
-    if (run_dir) write_file_atomic(run_dir->file("frames_" + r.name + ".csv"), frames_csv(r));
     json["evaluations"].push_back(to_json(r));
     results.push_back(std::move(r));
   }

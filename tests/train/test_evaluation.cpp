@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "core/error.h"
 #include "render_data/patch_sampler.h"
@@ -46,6 +47,45 @@ TEST(Evaluation, ConsecutiveFramesGiveTheSameScoresAsSingleFrames) {
     ASSERT_TRUE(one.frames[0].temporal_error && f.temporal_error);
     EXPECT_DOUBLE_EQ(*one.frames[0].temporal_error, *f.temporal_error);
   }
+}
+
+// A caller sees the quality (to write it out) before the latency is measured: at 1080p the
+// timing runs for minutes.
+TEST(Evaluation, QualityIsReportedBeforeTheLatency) {
+  const Dataset data = Dataset::open(tiny_data());
+  auto upscaler = classic_upscalers().get("bilinear")(2);
+  EvalOptions options = all_frames("0:2");
+  options.latency_runs = 3;
+  int calls = 0;
+  const EvalResult r = evaluate(*upscaler, data, options, [&](const EvalResult& early) {
+    ++calls;
+    EXPECT_EQ(early.frames.size(), 2u);
+    EXPECT_GT(early.psnr, 10);
+    EXPECT_FALSE(early.latency.has_value());
+  });
+  EXPECT_EQ(calls, 1);
+  ASSERT_TRUE(r.latency.has_value());
+  EXPECT_EQ(r.latency->runs, 3);
+}
+
+// Game captures store motion vectors at the render (LR) size only; the temporal error then uses
+// them repeated over each 2x2 block and doubled, which lands close to the HR vectors' figure.
+TEST(Evaluation, TemporalErrorFromMotionStoredAtLowResolutionOnly) {
+  const auto dir = scratch_dir("lr-motion");
+  const std::string root = tiny_data().string();
+  std::ofstream(dir / "capture.yaml") << "layout: glob\nresolutions:\n"
+                                         "  - {size: 64x48, color: '" << root << "/64x48/color/*.png', motion: '"
+                                      << root << "/64x48/motion/*.exr'}\n"
+                                         "  - {size: 128x96, color: '" << root << "/128x96/color/*.png'}\n";
+  const Dataset capture = Dataset::open(dir / "capture.yaml");
+  const Dataset native = Dataset::open(tiny_data());
+  auto upscaler = classic_upscalers().get("bicubic")(2);
+  const EvalResult from_lr = evaluate(*upscaler, capture, all_frames("1:6"));
+  const EvalResult from_hr = evaluate(*upscaler, native, all_frames("1:6"));
+  ASSERT_TRUE(from_lr.temporal_error && from_hr.temporal_error);
+  EXPECT_DOUBLE_EQ(from_lr.psnr, from_hr.psnr);
+  EXPECT_NE(*from_lr.temporal_error, *from_hr.temporal_error);
+  EXPECT_NEAR(*from_lr.temporal_error, *from_hr.temporal_error, 0.25 * *from_hr.temporal_error);
 }
 
 namespace {
