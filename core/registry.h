@@ -1,6 +1,12 @@
 #pragma once
-// Name -> factory tables. One registry per kind (backbones, losses, scene sources, ...), filled
-// explicitly by a register_builtins() function, never by static initializers the linker may drop.
+// Name -> factory tables. One registry per kind (backbones, scene sources, dataset layouts,
+// strategies, ...), each behind a function that fills it with the built-in entries on first use
+// (a function-local static), never by static initializers in other files the linker may drop:
+//
+//   Registry<Factory>& things() {
+//     static Registry<Factory> registry = [] { Registry<Factory> r("thing"); r.add(...); return r; }();
+//     return registry;
+//   }
 
 #include <map>
 #include <string>

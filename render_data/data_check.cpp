@@ -150,7 +150,6 @@ void check_through_loader(const Dataset& data, Collector& c) {
 DataCheckReport check_dataset(const fs::path& path, const DatasetOpenOptions& options, size_t max_messages) {
   DataCheckReport report;
   Collector c(report, max_messages);
-  register_builtin_dataset_loaders();
   const bool own = options.layout == "cgsr" || (options.layout == "auto" && fs::is_directory(path) && has_manifest(path));
   if (own) {
     // File by file, so one bad file does not hide the others; an incomplete render is a problem.

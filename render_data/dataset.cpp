@@ -117,21 +117,17 @@ std::unique_ptr<FrameSource> open_cgsr_dataset(const fs::path& root, const Datas
 // ---- registry -------------------------------------------------------------------------------------
 
 Registry<DatasetLoader>& dataset_loaders() {
-  static Registry<DatasetLoader> registry("dataset layout");
-  return registry;
-}
-
-void register_builtin_dataset_loaders() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    auto& r = dataset_loaders();
+  static Registry<DatasetLoader> registry = [] {
+    Registry<DatasetLoader> r("dataset layout");
     r.add("cgsr", {[](const fs::path& p) { return fs::is_directory(p) && has_manifest(p); }, open_cgsr_dataset},
           "cgsr's own format (manifest.yaml), written by `cgsr render`");
     r.add("cgsr-release", {looks_like_cgsr_release, open_cgsr_release},
           "the CGSR data release: <trace>/<width>/frame###.sim.ppm + feature###.bmp");
     r.add("glob", {looks_like_glob_layout, open_glob_layout},
           "per-channel glob patterns in a YAML file (layout: glob)");
-  });
+    return r;
+  }();
+  return registry;
 }
 
 // ---- Dataset ------------------------------------------------------------------------------------
@@ -176,7 +172,6 @@ struct Dataset::Impl {
 };
 
 Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
-  register_builtin_dataset_loaders();
   if (!fs::exists(path)) throw Error(path.string(), "no such dataset directory or file");
   auto& loaders = dataset_loaders();
   std::string layout = options.layout;

@@ -71,8 +71,7 @@ struct DatasetLoader {
   std::function<std::unique_ptr<FrameSource>(const std::filesystem::path&, const DatasetOpenOptions&)> open;
 };
 
-Registry<DatasetLoader>& dataset_loaders();
-void register_builtin_dataset_loaders();  // cgsr, cgsr-release, glob; calling again is harmless
+Registry<DatasetLoader>& dataset_loaders();  // cgsr, cgsr-release, glob already in it
 
 class Dataset {
  public:

@@ -67,7 +67,6 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
                                const std::function<void(int, int)>& progress) {
   const auto started = std::chrono::steady_clock::now();
   const auto resolutions = parse_resolutions(o.resolutions, "resolutions");
-  register_builtin_scene_sources();
   const SceneBundle bundle = make_scene(o.scene, seed);
 
   RenderJobResult result;

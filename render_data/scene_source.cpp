@@ -1,23 +1,18 @@
 #include "render_data/scene_source.h"
 
-#include <mutex>
-
 #include "render_data/procedural/procedural_scene.h"
 #include "render_data/q3/q3_scene_source.h"
 
 namespace cgsr {
 
 Registry<SceneSourceFactory>& scene_sources() {
-  static Registry<SceneSourceFactory> registry("scene source");
+  static Registry<SceneSourceFactory> registry = [] {
+    Registry<SceneSourceFactory> r("scene source");
+    register_procedural_scene_source(r);
+    q3::register_q3_scene_source(r);
+    return r;
+  }();
   return registry;
-}
-
-void register_builtin_scene_sources() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    register_procedural_scene_source();
-    q3::register_q3_scene_source(scene_sources());
-  });
 }
 
 SceneBundle make_scene(const config::Block& block, uint64_t seed) {

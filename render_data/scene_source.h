@@ -1,13 +1,12 @@
 #pragma once
 // Scene sources by name: a factory takes the {type: Name, ...} block of a render config and a
-// seed and returns the scene with its camera path. "procedural" is built in (procedural_scene.h);
-// other sources (e.g. a Quake III BSP loader) register themselves in register_builtin_scene_sources().
+// seed and returns the scene with its camera path. The registry fills itself with the built-in
+// sources on first use: "procedural" (procedural_scene.h) and "q3bsp" (q3/q3_scene_source.h).
 //
 //   scene:
 //     type: procedural      # the registry key
 //     layout: room          # everything else is the source's own options
 //
-//   register_builtin_scene_sources();
 //   SceneBundle bundle = make_scene(config_block, seed);
 
 #include <cstdint>
@@ -23,11 +22,8 @@ namespace cgsr {
 // block's file position. The same block and seed give the same scene.
 using SceneSourceFactory = std::function<SceneBundle(const config::Block& block, uint64_t seed)>;
 
-// The process-wide table of scene sources.
+// The process-wide table of scene sources, the built-in ones already in it.
 Registry<SceneSourceFactory>& scene_sources();
-
-// Registers every built-in source; calling it again is harmless.
-void register_builtin_scene_sources();
 
 // Looks up block.type, builds the scene, then validates the scene and its camera path.
 SceneBundle make_scene(const config::Block& block, uint64_t seed);

@@ -688,8 +688,8 @@ SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t see
   return LevelBuilder(options, seed).build();
 }
 
-void register_procedural_scene_source() {
-  scene_sources().add(
+void register_procedural_scene_source(Registry<SceneSourceFactory>& registry) {
+  registry.add(
       "procedural",
       [](const config::Block& block, uint64_t seed) {
         const auto options = config::parse_block_options(block, procedural_schema());

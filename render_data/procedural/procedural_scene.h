@@ -21,6 +21,7 @@
 
 #include "core/config.h"
 #include "render_data/scene.h"
+#include "render_data/scene_source.h"
 
 namespace cgsr {
 
@@ -77,7 +78,7 @@ config::Schema<ProceduralOptions> procedural_schema();
 // Builds the level; throws cgsr::Error when the layout leaves no room for the camera walk.
 SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed);
 
-// Registers "procedural" in the scene-source registry (called by register_builtin_scene_sources).
-void register_procedural_scene_source();
+// Adds "procedural" to a scene-source registry (scene_sources() does, when it is first used).
+void register_procedural_scene_source(Registry<SceneSourceFactory>& registry);
 
 }  // namespace cgsr

@@ -30,7 +30,6 @@ config::Schema<SceneConfig> scene_config_schema() {
 }
 
 SceneBundle build(const std::string& yaml, uint64_t seed) {
-  register_builtin_scene_sources();
   const auto doc = config::Document::parse(yaml, "test.yaml");
   config::Block block{doc.root(), std::make_shared<config::Document>(doc), ""};
   return make_scene(block, seed);
@@ -94,8 +93,7 @@ TEST(ProceduralScene, EveryShippedSceneConfigBuildsWithAFreeCameraPath) {
     // The whole file must parse as a render config (unknown keys would fail here).
     const SceneConfig config = config::parse_document(doc, scene_config_schema());
     parse_resolutions(config.resolutions, entry.path().string());
-    register_builtin_scene_sources();
-    const SceneBundle b = make_scene(config.scene, 1);
+      const SceneBundle b = make_scene(config.scene, 1);
     EXPECT_GT(b.scene.meshes.size(), 3u);
     EXPECT_GE(b.camera.keys.size(), 2u);
     expect_camera_in_free_space(b, entry.path().filename().string());

@@ -167,7 +167,6 @@ TEST_F(Q3SceneSource, RendersTheGamesColours) {
 }
 
 TEST_F(Q3SceneSource, TheRegistryBuildsItFromAConfigBlock) {
-  register_builtin_scene_sources();
   ASSERT_TRUE(scene_sources().contains("q3bsp"));
   const auto doc = std::make_shared<config::Document>(config::Document::parse(
       "scene:\n  type: q3bsp\n  map: tiny\n  data_root: ''\n  pk3: ['" + pk3_.string() +
