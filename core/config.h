@@ -31,6 +31,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/text.h"
 
@@ -116,6 +117,20 @@ struct Codec<V, std::enable_if_t<std::is_floating_point_v<V>>> {
     return v;
   }
   static YAML::Node encode(V v) { return YAML::Node(v); }
+};
+
+// A named enum (core/enum_names.h) is written as its name; an unknown name fails with the valid
+// ones and a did-you-mean.
+template <class V>
+struct Codec<V, std::enable_if_t<is_named_enum<V>::value>> {
+  static V decode(const YAML::Node& n, const Cursor& at) {
+    const auto name = detail::scalar_as<std::string>(n, at, "a string");
+    const auto& names = EnumNames<V>::names();
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) at.fail(n, unknown_enum_name<V>(name));
+    return static_cast<V>(it - names.begin());
+  }
+  static YAML::Node encode(V v) { return YAML::Node(enum_name(v)); }
 };
 
 template <>
@@ -231,6 +246,7 @@ class Schema {
     f.parse = [member](const YAML::Node& node, T& obj, const Cursor& at) { obj.*member = Codec<V>::decode(node, at); };
     f.emit = [member](const T& obj) { return Codec<V>::encode(obj.*member); };
     f.member = [member](const T& obj) -> const void* { return &(obj.*member); };
+    if constexpr (is_named_enum<V>::value) f.doc += " (one of: " + join(EnumNames<V>::names()) + ")";
     fields_.push_back(std::move(f));
     return FieldBuilder<V>(*this, fields_.size() - 1);
   }

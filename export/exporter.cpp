@@ -9,18 +9,9 @@
 
 namespace cgsr {
 
-const std::vector<std::string>& export_format_names() {
+const std::vector<std::string>& EnumNames<ExportFormat>::names() {
   static const std::vector<std::string> names = {"onnx", "torchscript"};
   return names;
-}
-
-const char* export_format_name(ExportFormat format) { return format == ExportFormat::Onnx ? "onnx" : "torchscript"; }
-
-ExportFormat export_format_from_name(const std::string& name) {
-  if (name == "onnx") return ExportFormat::Onnx;
-  if (name == "torchscript") return ExportFormat::TorchScript;
-  throw Error("format", "unknown export format '" + name + "' (valid: " + join(export_format_names()) + ")" +
-                            did_you_mean(name, export_format_names()));
 }
 
 std::vector<std::pair<std::string, std::string>> export_metadata(const SRNetworkImpl& net) {

@@ -14,16 +14,12 @@
 #include <utility>
 #include <vector>
 
+#include "export/export_format.h"
 #include "export/export_signature.h"
 #include "export/onnx_writer.h"
 #include "models/sr_network.h"
 
 namespace cgsr {
-
-enum class ExportFormat { Onnx, TorchScript };
-const char* export_format_name(ExportFormat format);  // "onnx", "torchscript"
-ExportFormat export_format_from_name(const std::string& name);  // cgsr::Error listing the valid names
-const std::vector<std::string>& export_format_names();
 
 struct ExportOptions {
   ExportFormat format = ExportFormat::Onnx;

@@ -91,7 +91,7 @@ torch::Tensor output_named(const NamedTensors& outputs, const std::string& file)
 std::string cannot_run(const VerifyCase& c, Runtime runtime) {
   const auto allowed = runtimes_for(c.format);
   if (std::find(allowed.begin(), allowed.end(), runtime) == allowed.end())
-    return std::string(runtime_name(runtime)) + " does not run " + export_format_name(c.format) + " files";
+    return std::string(runtime_name(runtime)) + " does not run " + enum_name(c.format) + " files";
   switch (runtime) {
     case Runtime::OnnxRuntime: return OnnxRuntimeRunner::unavailable_reason();
     case Runtime::OpenCvDnn: return opencv_dnn_unsupported_reason(c.file);

@@ -156,10 +156,10 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.source", "'" + spec.rit.source + "' is not one of: " + join(rit_sources(), ", ")});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", "must be at least 1, got " + std::to_string(spec.rit.hr_width)});
-  if (std::find(depth_encoding_names().begin(), depth_encoding_names().end(), spec.rit.depth_encoding) ==
-      depth_encoding_names().end())
+  if (std::find(EnumNames<DepthEncoding>::names().begin(), EnumNames<DepthEncoding>::names().end(), spec.rit.depth_encoding) ==
+      EnumNames<DepthEncoding>::names().end())
     problems.push_back({"rit.depth_encoding",
-                        "'" + spec.rit.depth_encoding + "' is not one of: " + join(depth_encoding_names(), ", ")});
+                        "'" + spec.rit.depth_encoding + "' is not one of: " + join(EnumNames<DepthEncoding>::names(), ", ")});
   if (spec.rit.fusion != "concat" && spec.rit.fusion != "add")
     problems.push_back({"rit.fusion", "'" + spec.rit.fusion + "' is not one of: concat, add"});
   if (spec.geometry.enabled && !spec.rit.enabled)
@@ -231,7 +231,7 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("hr_width", &RitSpec::hr_width, "features of the HR branch (hr_fuse)").at_least(1);
   rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone").one_of({"concat", "add"});
   rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network")
-      .one_of(depth_encoding_names());
+      .one_of(EnumNames<DepthEncoding>::names());
   return rit;
 }
 

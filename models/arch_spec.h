@@ -69,7 +69,7 @@ struct RitSpec {
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
-  DepthEncoding depth() const { return depth_encoding_from_name(depth_encoding); }
+  DepthEncoding depth() const { return enum_from_name<DepthEncoding>(depth_encoding); }
   // The parts the source asks for: the block at the backbone's feature map (lr, hr_pooled,
   // hr_unshuffle) and the branch at the HR features (hr_fuse).
   bool feature_branch() const { return source != "hr_fuse"; }

@@ -11,20 +11,9 @@
 
 namespace cgsr {
 
-MemoryLayout memory_layout_from_name(const std::string& name) {
-  if (name == "auto") return MemoryLayout::Auto;
-  if (name == "nchw") return MemoryLayout::Nchw;
-  if (name == "nhwc") return MemoryLayout::Nhwc;
-  throw Error("memory layout", "'" + name + "' is not one of: auto, nchw, nhwc");
-}
-
-const char* memory_layout_name(MemoryLayout layout) {
-  switch (layout) {
-    case MemoryLayout::Auto: return "auto";
-    case MemoryLayout::Nchw: return "nchw";
-    case MemoryLayout::Nhwc: return "nhwc";
-  }
-  return "?";
+const std::vector<std::string>& EnumNames<MemoryLayout>::names() {
+  static const std::vector<std::string> names = {"auto", "nchw", "nhwc"};
+  return names;
 }
 
 torch::Tensor to_layout(const torch::Tensor& t, MemoryLayout layout) {
@@ -59,7 +48,7 @@ MemoryLayout measured_layout(const std::string& key, const std::function<void(Me
   const auto stats = measure_latency_interleaved({[&] { run(MemoryLayout::Nchw); }, [&] { run(MemoryLayout::Nhwc); }},
                                                  /*warmup=*/1, rounds);
   const MemoryLayout best = stats[1].median_ms < stats[0].median_ms ? MemoryLayout::Nhwc : MemoryLayout::Nchw;
-  spdlog::info("layout for {}: {} (nchw {:.1f} ms, nhwc {:.1f} ms, median of {})", key, memory_layout_name(best),
+  spdlog::info("layout for {}: {} (nchw {:.1f} ms, nhwc {:.1f} ms, median of {})", key, enum_name(best),
                stats[0].median_ms, stats[1].median_ms, rounds);
   std::lock_guard<std::mutex> lock(mutex);
   return chosen.emplace(key, best).first->second;

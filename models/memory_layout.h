@@ -14,6 +14,8 @@
 #include <functional>
 #include <string>
 
+#include "core/enum_names.h"
+
 namespace cgsr {
 
 enum class MemoryLayout {
@@ -21,8 +23,11 @@ enum class MemoryLayout {
   Nchw,  // contiguous
   Nhwc,  // channels-last
 };
-MemoryLayout memory_layout_from_name(const std::string& name);  // auto | nchw | nhwc
-const char* memory_layout_name(MemoryLayout layout);
+template <>
+struct EnumNames<MemoryLayout> {
+  static constexpr const char* kind = "memory layout";
+  static const std::vector<std::string>& names();  // auto, nchw, nhwc
+};
 
 // A 4-D tensor in `layout` (a no-op when it already is); other tensors and Auto pass through.
 torch::Tensor to_layout(const torch::Tensor& t, MemoryLayout layout);

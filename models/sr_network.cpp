@@ -79,7 +79,7 @@ void SRNetworkImpl::check_depth_encoding(const Batch& batch) const {
   if (std::find(reads.begin(), reads.end(), RenderChannel::Depth) == reads.end() ||
       batch.depth_encoding == spec_.rit.depth())
     return;
-  throw Error(spec_summary(spec_), std::string("the batch's depth is ") + depth_encoding_name(batch.depth_encoding) +
+  throw Error(spec_summary(spec_), std::string("the batch's depth is ") + enum_name(batch.depth_encoding) +
                                        "-encoded, the model reads " + spec_.rit.depth_encoding +
                                        " (build batches with the model's depth_encoding())");
 }

@@ -10,10 +10,9 @@
 
 namespace cgsr {
 
-ImportanceMethod importance_method_from_name(const std::string& name) {
-  if (name == "taylor") return ImportanceMethod::Taylor;
-  if (name == "activation") return ImportanceMethod::Activation;
-  throw Error("importance", "unknown method '" + name + "' (taylor or activation)");
+const std::vector<std::string>& EnumNames<ImportanceMethod>::names() {
+  static const std::vector<std::string> names = {"taylor", "activation"};
+  return names;
 }
 
 std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::vector<PrunableUnit>& units) {

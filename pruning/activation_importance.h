@@ -18,7 +18,11 @@
 namespace cgsr {
 
 enum class ImportanceMethod { Taylor, Activation };
-ImportanceMethod importance_method_from_name(const std::string& name);  // taylor | activation
+template <>
+struct EnumNames<ImportanceMethod> {
+  static constexpr const char* kind = "importance";
+  static const std::vector<std::string>& names();  // taylor, activation
+};
 
 // For every group of `units`: importance [width] (CPU float) under the batch (summed over items).
 FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<PrunableUnit>& units,

@@ -54,7 +54,7 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
 
   // 1-2. Per-frame importance, then the pattern pool.
   const auto pool_frames = spread(train_frames, options.pool_frames);
-  const auto method = importance_method_from_name(options.importance);
+  const auto method = enum_from_name<ImportanceMethod>(options.importance);
   std::vector<FrameImportance> importance;
   {
     Progress progress("importance", static_cast<int64_t>(pool_frames.size()));

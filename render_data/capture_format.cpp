@@ -6,18 +6,10 @@
 #include <limits>
 
 #include "core/error.h"
-#include "core/text.h"
 #include "render_data/render_channels.h"
 
 namespace cgsr {
 namespace {
-
-template <class E>
-E enum_from_name(const std::string& name, const std::vector<std::string>& names, const char* what) {
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i] == name) return static_cast<E>(i);
-  throw Error(what, "'" + name + "' is not one of: " + join(names, ", "));
-}
 
 torch::Tensor no_geometry_where(const torch::Tensor& clear, const torch::Tensor& depth) {
   return torch::where(clear, torch::full({}, std::numeric_limits<float>::infinity()), depth);
@@ -25,20 +17,19 @@ torch::Tensor no_geometry_where(const torch::Tensor& clear, const torch::Tensor&
 
 }  // namespace
 
-const std::vector<std::string>& color_alpha_names() {
+const std::vector<std::string>& EnumNames<ColorAlpha>::names() {
   static const std::vector<std::string> names = {"ignore", "premultiplied"};
   return names;
 }
-ColorAlpha color_alpha_from_name(const std::string& name) {
-  return enum_from_name<ColorAlpha>(name, color_alpha_names(), "color_alpha");
-}
 
-const std::vector<std::string>& capture_depth_names() {
+const std::vector<std::string>& EnumNames<CaptureDepth>::names() {
   static const std::vector<std::string> names = {"normalized", "reversed", "linear", "linear_normalized"};
   return names;
 }
-CaptureDepth capture_depth_from_name(const std::string& name) {
-  return enum_from_name<CaptureDepth>(name, capture_depth_names(), "depth_encoding");
+
+const std::vector<std::string>& EnumNames<MotionUnits>::names() {
+  static const std::vector<std::string> names = {"pixels", "uv"};
+  return names;
 }
 
 config::Schema<MotionFormat> motion_format_schema() {
@@ -50,7 +41,7 @@ config::Schema<MotionFormat> motion_format_schema() {
   config::Schema<MotionFormat> s;
   s.section("x", &MotionFormat::x, c, "horizontal component");
   s.section("y", &MotionFormat::y, c, "vertical component");
-  s.field("units", &MotionFormat::units, "pixels, or uv (fractions of width and height)").one_of({"pixels", "uv"});
+  s.field("units", &MotionFormat::units, "pixels, or uv (fractions of width and height)");
   return s;
 }
 
@@ -131,7 +122,7 @@ torch::Tensor decode_capture_motion(const ImageFile& image, const MotionFormat& 
       value = raw / max_code;
     }
     auto px = (value.to(torch::kFloat64) - c.offset) * c.scale;
-    if (format.units == "uv") px = px * static_cast<double>(size);
+    if (format.units == MotionUnits::Uv) px = px * static_cast<double>(size);
     return px.to(torch::kFloat32);
   };
   return torch::stack({component(format.x, "x", W), component(format.y, "y", H)}, 0).contiguous();

@@ -31,12 +31,25 @@
 namespace cgsr {
 
 enum class ColorAlpha { Ignore, Premultiplied };
-const std::vector<std::string>& color_alpha_names();  // in enum order
-ColorAlpha color_alpha_from_name(const std::string& name);
+template <>
+struct EnumNames<ColorAlpha> {
+  static constexpr const char* kind = "color_alpha";
+  static const std::vector<std::string>& names();  // ignore, premultiplied
+};
 
 enum class CaptureDepth { Normalized, Reversed, Linear, LinearNormalized };
-const std::vector<std::string>& capture_depth_names();  // in enum order
-CaptureDepth capture_depth_from_name(const std::string& name);
+template <>
+struct EnumNames<CaptureDepth> {
+  static constexpr const char* kind = "depth_encoding";
+  static const std::vector<std::string>& names();  // normalized, reversed, linear, linear_normalized
+};
+
+enum class MotionUnits { Pixels, Uv };
+template <>
+struct EnumNames<MotionUnits> {
+  static constexpr const char* kind = "motion units";
+  static const std::vector<std::string>& names();  // pixels, uv
+};
 
 struct DepthFormat {
   CaptureDepth encoding = CaptureDepth::Normalized;
@@ -51,7 +64,7 @@ struct MotionComponent {
 
 struct MotionFormat {
   MotionComponent x{{0}}, y{{1}};
-  std::string units = "pixels";  // pixels | uv
+  MotionUnits units = MotionUnits::Pixels;
   bool declared = false;          // set when the YAML has the block (integer images need it)
 };
 config::Schema<MotionFormat> motion_format_schema();

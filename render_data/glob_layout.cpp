@@ -28,15 +28,15 @@ config::Schema<GlobLayoutOptions> glob_layout_schema() {
   s.field("near", &GlobLayoutOptions::near_plane, "near plane of the depth").range(1e-9, 1e12);
   s.field("far", &GlobLayoutOptions::far_plane, "far plane of the depth").range(1e-9, 1e30);
   s.field("vfov", &GlobLayoutOptions::vfov, "vertical field of view, degrees").range(1, 179);
-  s.field("color_alpha", &GlobLayoutOptions::color_alpha, "what the alpha of RGBA colour means").one_of(color_alpha_names());
-  s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored").one_of(capture_depth_names());
+  s.field("color_alpha", &GlobLayoutOptions::color_alpha, "what the alpha of RGBA colour means");
+  s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored");
   s.field("depth_scale", &GlobLayoutOptions::depth_scale, "linear depth: metres per stored unit").range(1e-12, 1e12);
   s.section("motion_format", &GlobLayoutOptions::motion_format, motion_format_schema(), "how motion images map to pixels");
   s.list("resolutions", &GlobLayoutOptions::resolutions, r, "one entry per resolution");
   s.validate([](const GlobLayoutOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (o.resolutions.empty()) at.child("resolutions").fail(node, "needs at least one resolution");
     if (!(o.far_plane > o.near_plane)) at.child("far").fail(node, "far must be larger than near");
-    if (o.depth_scale != 1 && o.depth_encoding != "linear")
+    if (o.depth_scale != 1 && o.depth_encoding != CaptureDepth::Linear)
       at.child("depth_scale").fail(node["depth_scale"], "applies to depth_encoding: linear only");
   });
   return s;
@@ -117,7 +117,7 @@ class GlobDataset : public FrameSource {
   GlobDataset(const fs::path& yaml, const DatasetOpenOptions& options) {
     const auto doc = config::Document::load_file(yaml);
     const auto o = config::parse_document(doc, glob_layout_schema());
-    color_alpha_ = color_alpha_from_name(o.color_alpha);
+    color_alpha_ = o.color_alpha;
     motion_format_ = o.motion_format;
     motion_format_.declared = static_cast<bool>(doc.root()["motion_format"]);
     const fs::path base = yaml.parent_path();
@@ -127,7 +127,7 @@ class GlobDataset : public FrameSource {
     info_.near_plane = options.near_plane > 0 ? options.near_plane : o.near_plane;
     info_.far_plane = options.far_plane > 0 ? options.far_plane : o.far_plane;
     info_.vfov = options.vfov > 0 ? options.vfov : o.vfov;
-    depth_format_.encoding = capture_depth_from_name(o.depth_encoding);
+    depth_format_.encoding = o.depth_encoding;
     depth_format_.near_plane = info_.near_plane;
     depth_format_.far_plane = info_.far_plane;
     depth_format_.scale = o.depth_scale;

@@ -46,8 +46,8 @@ struct GlobLayoutOptions {
   std::string layout = "glob";
   std::string name;
   double near_plane = 0.1, far_plane = 1000, vfov = 60;
-  std::string color_alpha = "ignore";
-  std::string depth_encoding = "normalized";
+  ColorAlpha color_alpha = ColorAlpha::Ignore;
+  CaptureDepth depth_encoding = CaptureDepth::Normalized;
   double depth_scale = 1;
   MotionFormat motion_format;
   std::vector<GlobResolution> resolutions;

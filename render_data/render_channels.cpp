@@ -79,23 +79,7 @@ torch::Tensor normalize_depth(const torch::Tensor& linear_depth, double near, do
   return ((inv_near - inv_z) / (inv_near - inv_far)).clamp(0.0, 1.0);
 }
 
-DepthEncoding depth_encoding_from_name(const std::string& name) {
-  if (name == "log") return DepthEncoding::Log;
-  if (name == "linear") return DepthEncoding::Linear;
-  if (name == "zbuffer") return DepthEncoding::ZBuffer;
-  throw Error("depth encoding", "'" + name + "' is not one of: " + join(depth_encoding_names(), ", "));
-}
-
-const char* depth_encoding_name(DepthEncoding encoding) {
-  switch (encoding) {
-    case DepthEncoding::Log: return "log";
-    case DepthEncoding::Linear: return "linear";
-    case DepthEncoding::ZBuffer: return "zbuffer";
-  }
-  return "?";
-}
-
-const std::vector<std::string>& depth_encoding_names() {
+const std::vector<std::string>& EnumNames<DepthEncoding>::names() {
   static const std::vector<std::string> names = {"log", "linear", "zbuffer"};
   return names;
 }
@@ -103,7 +87,7 @@ const std::vector<std::string>& depth_encoding_names() {
 torch::Tensor encode_depth(const torch::Tensor& linear_depth, double near, double far, DepthEncoding encoding) {
   if (encoding == DepthEncoding::ZBuffer) return normalize_depth(linear_depth, near, far);
   if (!(near > 0) || !(far > near) || std::isinf(far))
-    throw Error("depth", std::string("the ") + depth_encoding_name(encoding) +
+    throw Error("depth", std::string("the ") + enum_name(encoding) +
                              " encoding needs 0 < near < far < inf, got near " + std::to_string(near) + ", far " +
                              std::to_string(far));
   // Clamping first keeps log() finite (z = 0) and maps sky (z = +inf) to exactly 1.

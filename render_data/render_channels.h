@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.h"
+
 namespace cgsr {
 
 enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion };
@@ -52,9 +54,11 @@ torch::Tensor pick_channels(const torch::Tensor& info, const std::vector<RenderC
 // All clamp to [0,1] and give 1 at the far plane and beyond (sky); log and zbuffer give 0 at (and
 // before) the near plane, linear gives near/far there.
 enum class DepthEncoding { Log, Linear, ZBuffer };
-DepthEncoding depth_encoding_from_name(const std::string& name);  // cgsr::Error listing valid names
-const char* depth_encoding_name(DepthEncoding encoding);
-const std::vector<std::string>& depth_encoding_names();
+template <>
+struct EnumNames<DepthEncoding> {
+  static constexpr const char* kind = "depth encoding";
+  static const std::vector<std::string>& names();  // log, linear, zbuffer
+};
 torch::Tensor encode_depth(const torch::Tensor& linear_depth, double near, double far, DepthEncoding encoding);
 
 // The z-buffer value of a perspective projection, (1/near - 1/z) / (1/near - 1/far), clamped to [0,1]. 0 at the near

@@ -160,7 +160,7 @@ TrainOutput Trainer::forward(const Batch& batch, int step) {
 }
 
 MemoryLayout Trainer::choose_layout(const Batch& batch) {
-  const MemoryLayout requested = memory_layout_from_name(schedule_.layout);
+  const MemoryLayout requested = enum_from_name<MemoryLayout>(schedule_.layout);
   if (requested != MemoryLayout::Auto) return requested;
   // Forward and backward without hooks or optimizer step: gradients are zeroed before every
   // real step, so the measurement leaves nothing behind.
@@ -227,7 +227,7 @@ void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const
   archive.write("spec", text_tensor(spec_to_yaml(network_->spec())));
   archive.write("outcome", text_tensor(to_json(outcome).dump()));
   archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
-  archive.write("layout", text_tensor(memory_layout_name(layout_)));
+  archive.write("layout", text_tensor(enum_name(layout_)));
   write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
 }
 
@@ -281,7 +281,7 @@ bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, Trai
     outcome.last = score(j["last"]);
     for (const auto& s : j["history"]) outcome.history.push_back(score(s));
     torch::Tensor layout;
-    if (archive.try_read("layout", layout)) layout_ = memory_layout_from_name(tensor_text(layout));
+    if (archive.try_read("layout", layout)) layout_ = enum_from_name<MemoryLayout>(tensor_text(layout));
     archive.read("torch_rng", rng);
     at::Generator generator = at::detail::getDefaultCPUGenerator();  // a handle to the global generator
     generator.set_state(rng);
@@ -335,7 +335,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).
   if (layout_ == MemoryLayout::Auto) layout_ = choose_layout(sampler.build(step));
   set_parameter_layout(*network_, layout_);
-  outcome.layout = memory_layout_name(layout_);
+  outcome.layout = enum_name(layout_);
 
   network_->train();
   Progress progress("train", schedule_.steps, step);

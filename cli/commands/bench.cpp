@@ -139,9 +139,9 @@ BenchTarget model_target(const BenchOptions& options) {
     t.run = [fused, color, info] { fused->run(color, info); };
     return t;
   }
-  const MemoryLayout layout = inference_layout(*net, color, info, memory_layout_from_name(options.layout));
+  const MemoryLayout layout = inference_layout(*net, color, info, enum_from_name<MemoryLayout>(options.layout));
   t.runtime = "libtorch";
-  t.detail = std::string("layout ") + memory_layout_name(layout);
+  t.detail = std::string("layout ") + enum_name(layout);
   t.run = [net, color, info, layout]() mutable { infer(*net, color, info, layout); };
   return t;
 }

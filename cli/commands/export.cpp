@@ -20,7 +20,7 @@ config::Schema<ExportCommandOptions> export_schema() {
   s.field("model", &ExportCommandOptions::model, "backbone name, spec YAML file or model file to export").required();
   s.field("scale", &ExportCommandOptions::scale, "scale for a backbone name (0: 2, or the file's)")
       .check([](int v) { return v == 0 || (v >= 2 && v <= 4); }, "must be 0, 2, 3 or 4");
-  s.field("format", &ExportCommandOptions::format, "file format").one_of(export_format_names());
+  s.field("format", &ExportCommandOptions::format, "file format");
   s.field("input", &ExportCommandOptions::input, "LR input size WxH");
   s.field("dynamic_size", &ExportCommandOptions::dynamic_size, "ONNX: symbolic batch, height and width");
   s.field("cubic_resize", &ExportCommandOptions::cubic_resize,
@@ -31,7 +31,7 @@ config::Schema<ExportCommandOptions> export_schema() {
   s.field("out", &ExportCommandOptions::out, "the file to write").required();
   s.validate([](const ExportCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     parse_size(o.input, "input");
-    if (o.dynamic_size && o.format != "onnx")
+    if (o.dynamic_size && o.format != ExportFormat::Onnx)
       at.child("dynamic_size").fail(node, "only ONNX files have a fixed size; a TorchScript file takes any size");
   });
   add_run_settings(s);
@@ -63,7 +63,7 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   net->eval();
 
   ExportOptions o;
-  o.format = export_format_from_name(options.format);
+  o.format = options.format;
   o.width = w;
   o.height = h;
   o.dynamic_size = options.dynamic_size;
@@ -73,13 +73,13 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   nlohmann::ordered_json results;
   results["model"] = spec_summary(source.spec);
   results["file"] = exported.file.string();
-  results["format"] = export_format_name(exported.format);
+  results["format"] = enum_name(exported.format);
   results["bytes"] = exported.bytes;
   results["dynamic_size"] = exported.dynamic_size;
   results["signature"] = exported.dynamic_size ? signature_string(exported.signature, w, h) + " (any size)"
                                                : signature_string(exported.signature, w, h);
   std::printf("%s: %s, %s\n", exported.file.string().c_str(), results["model"].get<std::string>().c_str(),
-              export_format_name(exported.format));
+              enum_name(exported.format));
   std::printf("  %s\n", results["signature"].get<std::string>().c_str());
   if (exported.format == ExportFormat::Onnx) {
     const OnnxModelInfo info = inspect_onnx_file(exported.file);

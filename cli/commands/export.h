@@ -12,13 +12,14 @@
 #include <string>
 
 #include "cli/command.h"
+#include "export/export_format.h"
 
 namespace cgsr::cli {
 
 struct ExportCommandOptions : RunSettings {
   std::string model;              // backbone name, spec YAML or model file
   int scale = 0;                  // 0: the model file's scale, or 2 for a backbone name
-  std::string format = "onnx";    // onnx | torchscript
+  ExportFormat format = ExportFormat::Onnx;
   std::string input = "320x240";  // LR input size WxH (written into a fixed-size ONNX file)
   bool dynamic_size = false;      // ONNX: symbolic batch, height and width
   std::string cubic_resize = "conv";  // ONNX: bicubic resize as conv (portable) or native Resize

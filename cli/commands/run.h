@@ -26,6 +26,7 @@
 
 #include "cli/command.h"
 #include "cli/pipeline_verdict.h"
+#include "export/export_format.h"
 
 namespace cgsr::cli {
 
@@ -35,7 +36,7 @@ struct PipelineOptions : RunSettings {
   std::string data;                 // ...or an existing data set (then there is no render stage)
   std::vector<std::string> baselines = {"bicubic"};  // classic upscalers in the report (bicubic is always added)
   config::Block train, enhance, search, prune;      // the subcommands' configs, paths filled in
-  std::vector<std::string> export_formats = {"onnx", "torchscript"};
+  std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
   config::Block eval;                // EvalOptions shared by the eval and prune stages
   VerdictOptions verdict;
   std::string from;                  // rerun this stage and every later one

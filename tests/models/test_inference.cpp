@@ -34,9 +34,9 @@ TEST(Inference, MatchesForwardWithoutAutograd) {
 }
 
 TEST(Inference, LayoutNames) {
-  EXPECT_EQ(memory_layout_from_name("nhwc"), MemoryLayout::Nhwc);
-  EXPECT_STREQ(memory_layout_name(MemoryLayout::Auto), "auto");
-  EXPECT_THROW(memory_layout_from_name("chw"), Error);
+  EXPECT_EQ(enum_from_name<MemoryLayout>("nhwc"), MemoryLayout::Nhwc);
+  EXPECT_EQ(enum_name(MemoryLayout::Auto), "auto");
+  EXPECT_THROW(enum_from_name<MemoryLayout>("chw"), Error);
 }
 
 TEST(MemoryLayout, ParametersChangeLayoutInPlaceAndKeepValues) {

@@ -179,8 +179,8 @@ TEST(NetworkNumerics, ExtremeRenderingInformationGivesFiniteOutputsForEveryRitSo
   uint64_t seed = 2000;
   for (const auto& c : all_network_cases()) {
     if (c.source.empty()) continue;
-    for (const auto& encoding_name : depth_encoding_names()) {
-      const DepthEncoding encoding = depth_encoding_from_name(encoding_name);
+    for (const auto& encoding_name : EnumNames<DepthEncoding>::names()) {
+      const DepthEncoding encoding = enum_from_name<DepthEncoding>(encoding_name);
       SCOPED_TRACE(c.name() + ", " + encoding_name + " depth");
       ArchSpec spec = small_spec(c.backbone, c.source);
       spec.rit.depth_encoding = encoding_name;

@@ -85,7 +85,7 @@ TEST(CaptureFormat, DepthEncodingsDecodeTheirRampsWithTheirPrecision) {
     f.far_plane = far;
     f.scale = encoding == CaptureDepth::Linear ? 0.25 : 1;
     const auto map = decode_capture_depth(integer_image(codes, 8), f);
-    SCOPED_TRACE(capture_depth_names()[static_cast<size_t>(encoding)]);
+    SCOPED_TRACE(enum_name(encoding));
     ASSERT_FALSE(map.precision.exact());
     // Half a step of rounding, in 1/z.
     const auto step = map.precision.inverse_step + map.precision.linear_step * w * w;
@@ -117,7 +117,7 @@ TEST(CaptureFormat, MotionFromPackedCodes) {
   f.declared = true;
   f.x = {{0, 1}, 2.0, 0.5};
   f.y = {{2}, -8.0, 0.5};
-  f.units = "uv";
+  f.units = MotionUnits::Uv;
   const auto m = decode_capture_motion(integer_image(codes, 8), f);
   // uv of x times the width (1 pixel here), y in pixels too (uv of height 1).
   EXPECT_NEAR(m[0][0][0].item<float>(), (code / 65535.0 - 0.5) * 2, 1e-6);

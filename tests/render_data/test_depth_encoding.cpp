@@ -18,10 +18,10 @@ torch::Tensor depths(std::initializer_list<float> z) { return torch::tensor(std:
 }  // namespace
 
 TEST(DepthEncoding, NamesRoundTrip) {
-  for (const auto& name : depth_encoding_names())
-    EXPECT_EQ(depth_encoding_name(depth_encoding_from_name(name)), name);
+  for (const auto& name : EnumNames<DepthEncoding>::names())
+    EXPECT_EQ(enum_name(enum_from_name<DepthEncoding>(name)), name);
   try {
-    depth_encoding_from_name("logarithmic");
+    enum_from_name<DepthEncoding>("logarithmic");
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("log, linear, zbuffer"), std::string::npos) << e.what();
@@ -56,9 +56,9 @@ TEST(DepthEncoding, LinearAndZBuffer) {
 
 TEST(DepthEncoding, ExtremePlanesStayFiniteAndOrdered) {
   const auto z = depths({0.f, 1e-3f, 1.f, 1e3f, 1e6f, kInf});
-  for (const auto& name : depth_encoding_names()) {
+  for (const auto& name : EnumNames<DepthEncoding>::names()) {
     SCOPED_TRACE(name);
-    const auto v = encode_depth(z, 1e-3, 1e6, depth_encoding_from_name(name));
+    const auto v = encode_depth(z, 1e-3, 1e6, enum_from_name<DepthEncoding>(name));
     EXPECT_TRUE(torch::isfinite(v).all().item<bool>());
     EXPECT_GE(v.min().item<float>(), 0.f);
     EXPECT_LE(v.max().item<float>(), 1.f);
