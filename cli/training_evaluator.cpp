@@ -66,10 +66,10 @@ CandidateScore TrainingEvaluator::score(SRNetwork network, const ValidationScore
   return s;
 }
 
-CandidateScore TrainingEvaluator::evaluate_parent() {
-  Trainer trainer(parent_, data_, options_.schedule, options_.loss);
-  return score(parent_, trainer.validate(0), 0.0);
-}
+// The parent as a candidate equal to itself: faded (with nothing to fade), copied and trained
+// like any candidate. Validated untrained, it scored below candidates that had trained more, and
+// the pick rule compared unlike things.
+CandidateScore TrainingEvaluator::evaluate_parent() { return evaluate(parent_->spec()); }
 
 CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
   const auto started = std::chrono::steady_clock::now();

@@ -8,7 +8,8 @@
 //   2. cut: the candidate inherits the faded parent's most important channels (models/inherit.h);
 //   3. train: the candidate trains a few epochs with the CGSR loss, then is validated.
 // Every candidate is seeded from the global seed and its spec, so its score does not depend on
-// when it is evaluated: a resumed search reaches the same result.
+// when it is evaluated: a resumed search reaches the same result. The parent is scored as the
+// candidate equal to it (all three steps), not as it stands.
 
 #include <optional>
 

@@ -27,7 +27,8 @@ class Evaluator {
   // Trains (warm start from the parent) and validates one candidate. Must be deterministic for
   // a given spec, so that a resumed search reaches the same result.
   virtual CandidateScore evaluate(const ArchSpec& spec) = 0;
-  // The parent itself, validated the same way (no training).
+  // The parent itself, given exactly a candidate's treatment (same training, same validation),
+  // so the pick rule compares like with like.
   virtual CandidateScore evaluate_parent() = 0;
 };
 

@@ -42,6 +42,17 @@ Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& 
   return best ? *best : parent;
 }
 
+std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates) {
+  std::vector<Candidate> sorted = candidates;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const Candidate& a, const Candidate& b) {
+    return a.score.params != b.score.params ? a.score.params < b.score.params : a.score.val_psnr > b.score.val_psnr;
+  });
+  std::vector<Candidate> front;
+  for (const auto& c : sorted)
+    if (front.empty() || c.score.val_psnr > front.back().score.val_psnr) front.push_back(c);
+  return front;
+}
+
 SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
                         const SearchOptions& options) {
   const SearchSpace space(parent_spec, options.space);

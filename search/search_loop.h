@@ -47,6 +47,10 @@ struct SearchResult {
 Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& candidates,
                          const SearchOptions& options, bool* is_parent);
 
+// The candidates no other candidate beats on both size (params) and validation PSNR, smallest
+// first: what a search found, beyond its one pick.
+std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates);
+
 SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
                         const SearchOptions& options);
 

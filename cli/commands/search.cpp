@@ -98,6 +98,9 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
                {"score", to_json(result.pick.score)},
                {"is_parent", result.pick_is_parent}};
   j["param_reduction"] = reduction;
+  j["pareto_front"] = nlohmann::ordered_json::array();
+  for (const auto& c : pareto_front(result.evaluated))
+    j["pareto_front"].push_back({{"spec", spec_summary(c.spec)}, {"params", c.score.params}, {"val_psnr", c.score.val_psnr}});
   j["candidates"] = result.evaluated.size();
   j["generations"] = result.generations_run;
   j["stop_reason"] = result.stop_reason;

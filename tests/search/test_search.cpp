@@ -123,6 +123,21 @@ TEST(SearchLoop, PicksTheSmallestCandidateWithinTolerance) {
   EXPECT_TRUE(is_parent);
 }
 
+TEST(SearchLoop, ParetoFrontKeepsWhatNothingBeatsOnSizeAndQuality) {
+  std::vector<Candidate> cands(5);
+  cands[0].score = {32.0, 0, 0, 0, 300, 0, {}, 0};
+  cands[1].score = {31.5, 0, 0, 0, 400, 0, {}, 0};  // bigger and worse than [0]
+  cands[2].score = {33.0, 0, 0, 0, 800, 0, {}, 0};
+  cands[3].score = {32.5, 0, 0, 0, 600, 0, {}, 0};
+  cands[4].score = {32.2, 0, 0, 0, 300, 0, {}, 0};  // same size as [0], better
+  const auto front = pareto_front(cands);
+  ASSERT_EQ(front.size(), 3u);
+  EXPECT_EQ(front[0].score.val_psnr, 32.2);
+  EXPECT_EQ(front[1].score.params, 600);
+  EXPECT_EQ(front[2].score.params, 800);
+  EXPECT_TRUE(pareto_front({}).empty());
+}
+
 TEST(SearchLoop, EvolutionShrinksTheNetworkAndNeverRetrains) {
   seed_everything(11);
   ScoringEvaluator evaluator(enhanced_pan());
