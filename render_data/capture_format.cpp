@@ -74,8 +74,8 @@ CaptureDepthMap decode_capture_depth(const ImageFile& image, const DepthFormat& 
   switch (f.encoding) {
     case CaptureDepth::Normalized:
     case CaptureDepth::Reversed: {
+      if ((v > 1.0f + 1e-6f).any().item<bool>()) throw Error("depth", "z-buffer values above 1");
       const auto d = f.encoding == CaptureDepth::Normalized ? v : 1.0f - v;
-      if ((d > 1.0f + 1e-6f).any().item<bool>()) throw Error("depth", "z-buffer values above 1");
       out.depth = no_geometry_where(d >= 1.0f, linearize_depth(d, f.near_plane, f.far_plane));
       if (integer) out.precision.inverse_step = (inv_near - inv_far) / levels;
       break;
