@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 
+#include "core/pareto.h"
 #include "core/progress.h"
 #include "core/runtime.h"
 
@@ -43,13 +44,15 @@ Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& 
 }
 
 std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates) {
-  std::vector<Candidate> sorted = candidates;
-  std::stable_sort(sorted.begin(), sorted.end(), [](const Candidate& a, const Candidate& b) {
-    return a.score.params != b.score.params ? a.score.params < b.score.params : a.score.val_psnr > b.score.val_psnr;
-  });
+  std::vector<double> params, psnr;
+  for (const auto& c : candidates) {
+    params.push_back(static_cast<double>(c.score.params));
+    psnr.push_back(c.score.val_psnr);
+  }
   std::vector<Candidate> front;
-  for (const auto& c : sorted)
-    if (front.empty() || c.score.val_psnr > front.back().score.val_psnr) front.push_back(c);
+  for (size_t i : cgsr::pareto_front(params, psnr)) front.push_back(candidates[i]);
+  std::stable_sort(front.begin(), front.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score.params < b.score.params; });
   return front;
 }
 

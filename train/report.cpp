@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/pareto.h"
 #include "core/plot.h"
 #include "core/text.h"
 
@@ -50,20 +51,16 @@ std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
 }
 
 std::vector<size_t> pareto_front(const ReportTable& table) {
-  std::vector<size_t> front;
-  for (size_t i = 0; i < table.rows.size(); ++i) {
-    const auto& a = table.rows[i];
-    if (!a.latency) continue;
-    bool dominated = false;
-    for (size_t j = 0; j < table.rows.size() && !dominated; ++j) {
-      const auto& b = table.rows[j];
-      if (i == j || !b.latency) continue;
-      const bool no_worse = b.latency->median_ms <= a.latency->median_ms && b.psnr >= a.psnr;
-      const bool better = b.latency->median_ms < a.latency->median_ms || b.psnr > a.psnr;
-      dominated = no_worse && better;
+  std::vector<size_t> timed;  // rows without latency are on no front
+  std::vector<double> latency, psnr;
+  for (size_t i = 0; i < table.rows.size(); ++i)
+    if (table.rows[i].latency) {
+      timed.push_back(i);
+      latency.push_back(table.rows[i].latency->median_ms);
+      psnr.push_back(table.rows[i].psnr);
     }
-    if (!dominated) front.push_back(i);
-  }
+  std::vector<size_t> front;
+  for (size_t k : cgsr::pareto_front(latency, psnr)) front.push_back(timed[k]);
   return front;
 }
 
