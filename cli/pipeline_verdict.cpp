@@ -2,6 +2,7 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include <map>
 #include <optional>
 
 namespace cgsr::cli {
@@ -18,6 +19,16 @@ config::Schema<VerdictOptions> verdict_schema() {
           "test PSNR the CG-enhanced network must gain over the plain backbone trained as long (may be negative)");
   s.field("min_enhance_edge_gain_db", &VerdictOptions::min_enhance_edge_gain_db,
           "the same gain on geometry-edge pixels (the HR edge map dilated by 1 pixel)");
+  s.field("max_hybrid_latency_ratio", &VerdictOptions::max_hybrid_latency_ratio,
+          "mean latency per frame of the hybrid model against its static network's")
+      .at_least(0);
+  s.field("max_hybrid_loss_db", &VerdictOptions::max_hybrid_loss_db,
+          "test PSNR the hybrid model may lose against its static network")
+      .at_least(0);
+  s.field("min_hybrid_gain_over_magnitude_db", &VerdictOptions::min_hybrid_gain_over_magnitude_db,
+          "test PSNR the hybrid model must gain over magnitude pruning at its mean MACs (may be negative)");
+  s.field("min_patterns_used", &VerdictOptions::min_patterns_used, "distinct patterns chosen on the test frames")
+      .at_least(0);
   s.field("fail_run", &VerdictOptions::fail_run, "exit with an error when a check fails");
   return s;
 }
@@ -74,6 +85,46 @@ void check_gain(Verdict& v, const std::string& region, const EvalResult& a, cons
                       fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", *a_psnr, *b_psnr, *a_psnr - *b_psnr)});
 }
 
+// What the per-frame choice buys against the static network it chooses within.
+void check_dynamic_pruning(Verdict& v, const EvalResult& hybrid, const EvalResult& fixed, const EvalResult* magnitude,
+                           const VerdictOptions& options) {
+  const std::string latency_claim =
+      fmt::format("{} runs at most {:g}x its static network's mean latency", hybrid.name, options.max_hybrid_latency_ratio);
+  if (hybrid.latency && fixed.latency) {
+    const double ratio = hybrid.latency->mean_ms / fixed.latency->mean_ms;
+    v.checks.push_back({latency_claim, ratio <= options.max_hybrid_latency_ratio,
+                        fmt::format("{:.1f} ms against {:.1f} ms per frame ({:.2f}x; p95 {:.1f} against {:.1f} ms)",
+                                    hybrid.latency->mean_ms, fixed.latency->mean_ms, ratio, hybrid.latency->p95_ms,
+                                    fixed.latency->p95_ms)});
+  } else {
+    v.checks.push_back({latency_claim, false, "latency was not measured (eval.latency_runs is 0)"});
+  }
+  const double loss = fixed.psnr - hybrid.psnr;
+  v.checks.push_back({fmt::format("{} loses at most {:g} dB against its static network", hybrid.name,
+                                  options.max_hybrid_loss_db),
+                      loss <= options.max_hybrid_loss_db,
+                      fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", hybrid.psnr, fixed.psnr, -loss)});
+  if (magnitude) {
+    const double gain = hybrid.psnr - magnitude->psnr;
+    v.checks.push_back(
+        {fmt::format("{} gains at least {:g} dB over {}", hybrid.name, options.min_hybrid_gain_over_magnitude_db,
+                     magnitude->name),
+         gain >= options.min_hybrid_gain_over_magnitude_db,
+         fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB) at {:.3g} against {:.3g} MACs", hybrid.psnr,
+                     magnitude->psnr, gain, hybrid.cost ? static_cast<double>(hybrid.cost->macs) : 0.0,
+                     magnitude->cost ? static_cast<double>(magnitude->cost->macs) : 0.0)});
+  }
+  std::map<int, int> used;
+  for (const auto& f : hybrid.frames)
+    if (f.details.is_object() && f.details.contains("pattern")) ++used[f.details["pattern"].get<int>()];
+  std::string shares;
+  for (const auto& [k, n] : used) shares += fmt::format("{}pattern {}: {} frames", shares.empty() ? "" : ", ", k, n);
+  v.checks.push_back({fmt::format("{} uses at least {} patterns on the test frames", hybrid.name,
+                                  options.min_patterns_used),
+                      static_cast<int>(used.size()) >= options.min_patterns_used,
+                      used.empty() ? "no frame recorded a pattern" : shares});
+}
+
 }  // namespace
 
 Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) {
@@ -92,6 +143,7 @@ Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) 
   }
   if (r.cg_enhanced && r.cg_optimized) check_cuts(v, "search", *r.cg_enhanced, *r.cg_optimized, options.max_search_loss_db);
   if (r.cg_optimized && r.pruned) check_cuts(v, "pruning", *r.cg_optimized, *r.pruned, options.max_prune_loss_db);
+  if (r.pruned && r.pruned_static) check_dynamic_pruning(v, *r.pruned, *r.pruned_static, r.magnitude, options);
   return v;
 }
 

@@ -8,7 +8,12 @@
 //   - the search cuts params, MACs and latency of the CG-enhanced network, losing at most
 //     `max_search_loss_db` PSNR;
 //   - pruning cuts params, MACs and latency of the searched network, losing at most
-//     `max_prune_loss_db` PSNR.
+//     `max_prune_loss_db` PSNR;
+//   - the dynamic part pays: the hybrid model's mean latency per frame (over the test frames in
+//     turn) is at most `max_hybrid_latency_ratio` of its static network's, it loses at most
+//     `max_hybrid_loss_db` against the static network, gains at least
+//     `min_hybrid_gain_over_magnitude_db` over magnitude pruning at its mean MACs, and uses at
+//     least `min_patterns_used` patterns on the test frames.
 // Every figure in a check's detail comes from the evaluations; the thresholds are the config's.
 
 #include <nlohmann/json.hpp>
@@ -25,6 +30,10 @@ struct VerdictOptions {
   double max_prune_loss_db = 0.3;   // PSNR the pruned network may lose against its input
   double min_enhance_gain_db = 0;       // PSNR the CG-enhanced network must gain over the control
   double min_enhance_edge_gain_db = 0;  // the same on geometry-edge pixels
+  double max_hybrid_latency_ratio = 0.8;  // hybrid mean latency per frame against its static network's
+  double max_hybrid_loss_db = 0.05;       // PSNR the hybrid model may lose against its static network
+  double min_hybrid_gain_over_magnitude_db = 0.05;  // against magnitude pruning at the same mean MACs
+  int min_patterns_used = 3;              // distinct patterns chosen on the test frames
   bool fail_run = true;             // a failed check makes `cgsr run` exit with an error
 };
 config::Schema<VerdictOptions> verdict_schema();
@@ -37,6 +46,8 @@ struct PipelineResults {
   const EvalResult* cg_enhanced = nullptr;   // backbone + RIT
   const EvalResult* cg_optimized = nullptr;  // the search's pick, trained longer
   const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network
+  const EvalResult* pruned_static = nullptr;  // the hybrid model's static network alone
+  const EvalResult* magnitude = nullptr;     // magnitude pruning at the hybrid's mean MACs
   std::vector<const EvalResult*> networks() const;  // every non-null learned model
 };
 

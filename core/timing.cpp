@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/error.h"
 
@@ -20,6 +21,13 @@ LatencyStats summarize(const std::vector<double>& ms) {
   s.median_ms = median(ms);
   s.min_ms = *std::min_element(ms.begin(), ms.end());
   s.max_ms = *std::max_element(ms.begin(), ms.end());
+  double sum = 0;
+  for (double v : ms) sum += v;
+  s.mean_ms = sum / static_cast<double>(ms.size());
+  std::vector<double> sorted = ms;
+  std::sort(sorted.begin(), sorted.end());
+  const size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(sorted.size())));
+  s.p95_ms = sorted[std::max<size_t>(rank, 1) - 1];
   s.runs = static_cast<int>(ms.size());
   return s;
 }

@@ -9,6 +9,7 @@ namespace cgsr {
 
 struct LatencyStats {
   double median_ms = 0, min_ms = 0, max_ms = 0;
+  double mean_ms = 0, p95_ms = 0;  // p95: the nearest-rank 95th percentile
   int runs = 0;
 };
 

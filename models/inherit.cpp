@@ -106,9 +106,12 @@ std::map<std::string, std::vector<int64_t>> choose_channels(const graph::Graph& 
       CGSR_CHECK(static_cast<int64_t>(c.size()) == width,
                  "inherit: group " + group + " is " + std::to_string(width) + " wide but " + std::to_string(c.size()) +
                      " channels were chosen");
-      for (size_t i = 0; i < c.size(); ++i)
-        CGSR_CHECK(c[i] >= 0 && c[i] < it->second.numel() && (i == 0 || c[i] > c[i - 1]),
-                   "inherit: chosen channels of group " + group + " must be increasing parent indices");
+      std::vector<bool> seen(it->second.numel(), false);
+      for (int64_t i : c) {
+        CGSR_CHECK(i >= 0 && i < it->second.numel() && !seen[i],
+                   "inherit: chosen channels of group " + group + " must be distinct parent indices");
+        seen[i] = true;
+      }
       kept[group] = c;
       continue;
     }

@@ -33,8 +33,9 @@ struct Inheritance {
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec);
 
 // The same with the channels of some groups chosen by the caller (pruning): `kept[group]` lists
-// parent channel indices, strictly increasing, as many as the child's width of that group.
-// Groups not listed are chosen by importance as above.
+// distinct parent channel indices in the child's channel order, as many as the child's width of
+// that group (a permutation of a same-width group reorders its channels). Groups not listed are
+// chosen by importance as above.
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec,
                     const std::map<std::string, std::vector<int64_t>>& kept);
 

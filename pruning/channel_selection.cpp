@@ -13,7 +13,11 @@ const std::vector<int64_t>* find_kept(const ChannelSelection& keep, const graph:
   return it == keep.end() ? nullptr : &it->second;
 }
 
+// A leading run of positions 0, 1, ..., n - 1 (nested patterns) is a view; anything else a copy.
 torch::Tensor take(const torch::Tensor& t, int64_t dim, const std::vector<int64_t>& index) {
+  bool prefix = true;
+  for (size_t i = 0; i < index.size() && prefix; ++i) prefix = index[i] == static_cast<int64_t>(i);
+  if (prefix) return t.narrow(dim, 0, static_cast<int64_t>(index.size()));
   return t.index_select(dim, torch::tensor(index, torch::kLong)).contiguous();
 }
 

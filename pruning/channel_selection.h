@@ -32,8 +32,9 @@ graph::Layout selected_layout(const graph::Layout& layout, const ChannelSelectio
 // throws cgsr::Error naming the group otherwise.
 void check_selection(const graph::Graph& graph, const ChannelSelection& keep, const std::string& context);
 
-// The graph restricted to the selection: Conv and ChannelAffine tensors are gathered copies,
-// every value's layout narrowed. Ops and values keep their indices and names.
+// The graph restricted to the selection: Conv and ChannelAffine tensors are gathered copies, or
+// views where the kept positions are a leading run (the first channels of a group), every value's
+// layout narrowed. Ops and values keep their indices and names.
 graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep);
 
 // The gathered tensors of one op under a selection (what select_channels puts into the op).

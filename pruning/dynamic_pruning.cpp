@@ -4,9 +4,14 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <numeric>
+#include <random>
 
 #include "core/error.h"
+#include "core/metrics.h"
+#include "core/progress.h"
 #include "render_data/patch_sampler.h"
+#include "train/losses.h"
 
 namespace cgsr {
 
@@ -26,11 +31,33 @@ config::Schema<FinetuneOptions> finetune_schema() {
   s.section("schedule", &FinetuneOptions::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &FinetuneOptions::loss, loss_schema(), "image term (L2 in the paper) and RIT gate penalty");
   s.field("lambda_pruned", &FinetuneOptions::lambda_pruned,
-          "weight of the L1 norm of the weights the patterns leave out (Eq. 4)")
+          "weight of the L1 norm of the weights a pattern leaves out (Eq. 4)")
       .at_least(0);
-  s.field("soft_fraction", &FinetuneOptions::soft_fraction,
-          "fraction of the steps with soft (averaged) patterns before the chosen ones")
-      .range(0.0, 1.0);
+  s.field("sampled_patterns", &FinetuneOptions::sampled_patterns,
+          "patterns between the widest and the narrowest trained per step (sandwich rule)")
+      .range(0, 64);
+  return s;
+}
+
+const std::vector<std::string>& EnumNames<PatternCost>::names() {
+  static const std::vector<std::string> n{"macs", "latency"};
+  return n;
+}
+
+config::Schema<SelectorOptions> selector_schema() {
+  config::Schema<SelectorOptions> s;
+  s.field("cost", &SelectorOptions::cost, "what a pattern costs: macs (reproducible) or latency (measured here)");
+  s.field("budget", &SelectorOptions::budget,
+          "mean per-frame cost the choices aim at, as a fraction of the widest pattern's")
+      .check([](double v) { return v > 0 && v <= 1; }, "must be in (0, 1]");
+  s.field("temperature", &SelectorOptions::temperature,
+          "dB: cost differences below this count as near-ties when the sampler is fitted")
+      .range(1e-6, 100.0);
+  s.field("steps", &SelectorOptions::steps, "optimizer steps fitting the sampler").range(0, 1000000);
+  s.field("learning_rate", &SelectorOptions::learning_rate, "sampler learning rate").range(1e-9, 10.0);
+  s.field("frames", &SelectorOptions::frames, "training frames measured and fitted on (0 = all)").at_least(0);
+  s.field("latency_runs", &SelectorOptions::latency_runs, "rounds timing every pattern for the latency table")
+      .range(1, 1000);
   return s;
 }
 
@@ -46,16 +73,34 @@ int finetune_steps(const FinetuneOptions& options, const Dataset& data, int scal
   return std::max(1, static_cast<int>(std::ceil(options.epochs * pixels / per_step)));
 }
 
+nlohmann::ordered_json to_json(const SelectorFit& fit) {
+  nlohmann::ordered_json j;
+  j["frames"] = fit.frames;
+  j["latency_ms"] = fit.latency_ms;
+  j["cost"] = fit.cost;
+  j["price_db"] = fit.price;
+  j["best"] = fit.best;
+  j["chosen"] = fit.chosen;
+  j["agreement"] = fit.agreement;
+  j["mean_cost"] = fit.mean_cost;
+  auto mean_loss = nlohmann::ordered_json::array();
+  for (size_t k = 0; k < fit.latency_ms.size(); ++k) {
+    double sum = 0;
+    for (const auto& f : fit.loss_db) sum += f[k];
+    mean_loss.push_back(fit.loss_db.empty() ? 0.0 : sum / static_cast<double>(fit.loss_db.size()));
+  }
+  j["mean_loss_db"] = mean_loss;
+  return j;
+}
+
 DynamicPruning::DynamicPruning(SRNetwork network, const Dataset& data, PatternPool pool, const SamplerOptions& options)
     : network_(std::move(network)), data_(data), pool_(std::move(pool)) {
   channels_ = options.render_channels();
   for (auto c : channels_)
     if (std::find(data.info().channels.begin(), data.info().channels.end(), c) == data.info().channels.end())
-      throw Error(data.info().root.string(), "the dynamic samplers read rendering channel '" + channel_name(c) +
+      throw Error(data.info().root.string(), "the dynamic sampler reads rendering channel '" + channel_name(c) +
                                                  "', which the data set does not have");
-  std::vector<int> sizes;
-  for (const auto& u : pool_.units) sizes.push_back(static_cast<int>(u.patterns.size()));
-  samplers_ = DynamicSamplers(options, sizes);
+  samplers_ = DynamicSamplers(options, std::vector<int>{pool_.size()});
   masks_ = std::make_unique<PatternMasks>(*network_, pool_);
 }
 
@@ -63,7 +108,7 @@ torch::Tensor DynamicPruning::sampler_input(int frame) {
   auto it = inputs_.find(frame);
   if (it != inputs_.end()) return it->second;
   const int scale = network_->spec().scale;
-  // The samplers see depth as the network does: at inference both read the one batch.
+  // The sampler sees depth as the network does: at inference both read the one batch.
   const DepthEncoding depth = network_->depth_encoding();
   const auto info = frame_batch(data_, frame, scale, channels_, depth).lr_info;
   torch::Tensor previous;
@@ -78,78 +123,161 @@ torch::Tensor DynamicPruning::sampler_inputs(const std::vector<int>& frames) {
   return torch::cat(parts, 0);
 }
 
-double DynamicPruning::warm_up(const std::vector<int>& frames, const std::vector<std::vector<int>>& assignment,
-                               int steps, double learning_rate) {
-  CGSR_CHECK(frames.size() == assignment.size(), "warm_up: one assignment per frame");
-  const auto input = sampler_inputs(frames);
-  const int64_t n = static_cast<int64_t>(frames.size()), units = static_cast<int64_t>(pool_.units.size());
-  auto target = torch::empty({n, units}, torch::kLong);
+namespace {
+// The patterns besides the widest that a step trains: the narrowest and `sampled` distinct
+// others, drawn from the step number (the same after a resume).
+std::vector<int> sandwich(int patterns, int sampled, int step) {
+  std::vector<int> out;
+  if (patterns < 2) return out;
+  out.push_back(patterns - 1);
+  std::vector<int> middle(patterns - 2);
+  std::iota(middle.begin(), middle.end(), 1);
+  std::mt19937 rng(static_cast<uint32_t>(step) * 2654435761u + 17u);
+  std::shuffle(middle.begin(), middle.end(), rng);
+  for (int i = 0; i < sampled && i < static_cast<int>(middle.size()); ++i) out.push_back(middle[i]);
+  return out;
+}
+}  // namespace
+
+TrainHooks DynamicPruning::hooks(const FinetuneOptions& options) {
+  TrainHooks hooks;
+  // The widest pattern is the trainer's own forward (and what validation measures).
+  hooks.forward = [this](const Batch& batch, int) {
+    TrainOutput out;
+    out.image = masks_->forward(batch.lr_color, network_->info_input(batch),
+                                masks_->group_masks(0, batch.lr_color.size(0)));
+    return out;
+  };
+  const LossOptions loss = options.loss;
+  const double lambda = options.lambda_pruned;
+  const int sampled = options.sampled_patterns;
+  hooks.extra_loss = [this, loss, lambda, sampled](const Batch& batch, const TrainOutput&, int step) {
+    const int64_t n = batch.lr_color.size(0);
+    auto total = lambda > 0 ? lambda * masks_->pruned_weight_l1(masks_->group_masks(0, n)) : torch::zeros({});
+    for (int k : sandwich(pool_.size(), sampled, step)) {
+      const auto masks = masks_->group_masks(k, n);
+      const auto out = masks_->forward(batch.lr_color, network_->info_input(batch), masks);
+      total = total + reconstruction_error(out, batch.hr_color, loss.image_norm);
+      if (lambda > 0) total = total + lambda * masks_->pruned_weight_l1(masks);
+    }
+    return total;
+  };
+  return hooks;
+}
+
+namespace {
+// Per frame, the pattern of least loss_db + price * latency fraction (ties: the wider one).
+std::vector<int> cheapest(const std::vector<std::vector<double>>& loss_db, const std::vector<double>& fraction,
+                          double price) {
+  std::vector<int> best;
+  for (const auto& f : loss_db) {
+    int b = 0;
+    for (int k = 1; k < static_cast<int>(f.size()); ++k)
+      if (f[k] + price * fraction[k] < f[b] + price * fraction[b]) b = k;
+    best.push_back(b);
+  }
+  return best;
+}
+
+double mean_fraction(const std::vector<int>& choice, const std::vector<double>& fraction) {
+  double sum = 0;
+  for (int k : choice) sum += fraction[k];
+  return choice.empty() ? 1.0 : sum / static_cast<double>(choice.size());
+}
+}  // namespace
+
+SelectorFit DynamicPruning::fit_selector(const std::vector<int>& frames, const SelectorOptions& options) {
+  if (frames.empty()) throw Error("dynamic pruning", "no frames to fit the pattern choice on");
+  SelectorFit fit;
+  fit.frames = frames;
+  const int scale = network_->spec().scale;
+  const int patterns = pool_.size();
+  network_->eval();
+  PatternNetworks networks(*network_, pool_);
+
+  // The latency table and the costs, on the first frame.
+  {
+    const Batch b = frame_batch(data_, frames.front(), scale, network_->input_channels(), network_->depth_encoding());
+    const auto info = network_->info_input(b);
+    for (const auto& l : networks.measure_latency(b.lr_color, info, options.latency_runs))
+      fit.latency_ms.push_back(l.median_ms);
+    std::vector<double> macs;
+    for (int k = 0; k < patterns; ++k)
+      macs.push_back(static_cast<double>(networks.cost(k, b.lr_color.size(3), b.lr_color.size(2)).macs));
+    const auto& measure = options.cost == PatternCost::Macs ? macs : fit.latency_ms;
+    for (double v : measure) fit.cost.push_back(v / measure.front());
+  }
+  const std::vector<double>& fraction = fit.cost;
+
+  // Each pattern's PSNR on every frame.
+  {
+    Progress progress("pattern losses", static_cast<int64_t>(frames.size()));
+    for (int f : frames) {
+      const Batch b = frame_batch(data_, f, scale, network_->input_channels(), network_->depth_encoding());
+      const auto info = network_->info_input(b);
+      std::vector<double> psnr_k;
+      for (int k = 0; k < patterns; ++k) {
+        const auto sr = networks.run(k, b.lr_color, info);
+        if (!torch::isfinite(sr).all().item<bool>())
+          throw Error("dynamic pruning: frame " + std::to_string(f), "pattern " + std::to_string(k) +
+                                                                         " produced NaN or infinite values");
+        psnr_k.push_back(psnr(sr.clamp(0.0, 1.0), b.hr_color).item<double>());
+      }
+      std::vector<double> loss;
+      for (double p : psnr_k) loss.push_back(std::isinf(psnr_k[0]) && std::isinf(p) ? 0.0 : psnr_k[0] - p);
+      fit.loss_db.push_back(loss);
+      progress.advance();
+    }
+    progress.finish();
+  }
+
+  // The price of latency that meets the budget on average.
+  double low = 0, high = 1;
+  if (mean_fraction(cheapest(fit.loss_db, fraction, 0), fraction) <= options.budget) {
+    high = 0;
+  } else {
+    while (mean_fraction(cheapest(fit.loss_db, fraction, high), fraction) > options.budget && high < 1e6)
+      high *= 2;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (low + high);
+      (mean_fraction(cheapest(fit.loss_db, fraction, mid), fraction) > options.budget ? low : high) = mid;
+    }
+  }
+  fit.price = high;
+  fit.best = cheapest(fit.loss_db, fraction, fit.price);
+
+  // Fit the sampler to the per-frame cost distributions.
+  const int64_t n = static_cast<int64_t>(frames.size());
+  auto cost = torch::empty({n, patterns}, torch::kFloat);
   for (int64_t i = 0; i < n; ++i)
-    for (int64_t u = 0; u < units; ++u) target[i][u] = assignment[i][u];
+    for (int k = 0; k < patterns; ++k)
+      cost[i][k] = static_cast<float>(fit.loss_db[i][k] + fit.price * fraction[k]);
+  const auto target = torch::softmax(-cost / options.temperature, 1);
+  const auto input = sampler_inputs(frames);
   samplers_->train();
-  torch::optim::Adam optimizer(samplers_->parameters(), torch::optim::AdamOptions(learning_rate));
-  for (int step = 0; step < steps; ++step) {
-    const auto scores = samplers_->forward(input);  // [N, U, K]
-    const auto loss = torch::nn::functional::cross_entropy(scores.reshape({n * units, -1}), target.reshape({-1}));
+  torch::optim::Adam optimizer(samplers_->parameters(), torch::optim::AdamOptions(options.learning_rate));
+  for (int step = 0; step < options.steps; ++step) {
+    const auto scores = samplers_->forward(input).select(1, 0);  // [N, K]
+    const auto loss = -(target * torch::log_softmax(scores, 1)).sum(1).mean();
     optimizer.zero_grad();
     loss.backward();
     optimizer.step();
   }
   samplers_->eval();
-  torch::NoGradGuard no_grad;
-  const auto chosen = samplers_->forward(input).argmax(2);
-  return chosen.eq(target).to(torch::kDouble).mean().item<double>();
-}
-
-std::vector<torch::Tensor> DynamicPruning::pattern_weights(const torch::Tensor& input, bool soft, bool training) {
-  const auto scores = samplers_->forward(input);
-  std::vector<torch::Tensor> out;
-  for (size_t u = 0; u < pool_.units.size(); ++u) {
-    const int64_t k = static_cast<int64_t>(pool_.units[u].patterns.size());
-    const auto s = scores.select(1, static_cast<int64_t>(u)).slice(1, 0, k);
-    const auto hard = torch::one_hot(s.argmax(1), k).to(s.dtype());
-    if (!training) {
-      out.push_back(hard);
-      continue;
-    }
-    const auto p = torch::softmax(s, 1);
-    out.push_back(soft ? p : hard + (p - p.detach()));
+  int agree = 0;
+  for (int64_t i = 0; i < n; ++i) {
+    fit.chosen.push_back(samplers_->choose(input.slice(0, i, i + 1)).front().front());
+    agree += fit.chosen.back() == fit.best[i];
   }
-  return out;
+  fit.agreement = static_cast<double>(agree) / static_cast<double>(n);
+  fit.mean_cost = mean_fraction(fit.chosen, fraction);
+  return fit;
 }
 
-TrainHooks DynamicPruning::hooks(const FinetuneOptions& options, int total_steps) {
-  TrainHooks hooks;
-  const int soft_steps = static_cast<int>(std::lround(options.soft_fraction * total_steps));
-  hooks.forward = [this, soft_steps](const Batch& batch, int step) {
-    if (batch.frames.size() != static_cast<size_t>(batch.lr_color.size(0)))
-      throw Error("dynamic pruning", "the batch does not say which frame each item comes from", ErrorKind::Internal);
-    const bool training = network_->is_training();
-    samplers_->train(training);
-    const auto weights = pattern_weights(sampler_inputs(batch.frames), step < soft_steps, training);
-    auto masks = masks_->group_masks(weights);
-    TrainOutput out;
-    out.image = masks_->forward(batch.lr_color, network_->info_input(batch), masks);
-    if (training) last_masks_ = std::move(masks);
-    return out;
-  };
-  const double lambda = options.lambda_pruned;
-  if (lambda > 0)
-    hooks.extra_loss = [this, lambda](const Batch&, const TrainOutput&, int) {
-      return lambda * masks_->pruned_weight_l1(last_masks_);
-    };
-  hooks.extra_parameters = samplers_->parameters();
-  return hooks;
-}
-
-std::vector<std::vector<int64_t>> DynamicPruning::selection_counts(const std::vector<int>& frames) {
-  std::vector<std::vector<int64_t>> counts;
-  for (const auto& u : pool_.units) counts.emplace_back(u.patterns.size(), 0);
+std::vector<int64_t> DynamicPruning::selection_counts(const std::vector<int>& frames) {
+  std::vector<int64_t> counts(pool_.size(), 0);
   samplers_->eval();
-  for (int f : frames) {
-    const auto choice = samplers_->choose(sampler_input(f)).front();
-    for (size_t u = 0; u < choice.size(); ++u) ++counts[u][choice[u]];
-  }
+  for (int f : frames) ++counts[samplers_->choose(sampler_input(f)).front().front()];
   return counts;
 }
 

@@ -1,27 +1,33 @@
 #pragma once
-// Training the dynamic pruning components of a network on a data set (the paper's "partially
-// train and fine-tune the dynamic sampler for a specific CG application"):
+// Training the dynamic pruning of a network on a data set, in two steps:
 //
-//   1. warm_up(): the samplers learn to predict, from each training frame's rendering
-//      information, the pool entry its own importance ranking was merged into (cross-entropy).
-//   2. hooks(): the Trainer fine-tunes network and samplers together with
-//      L_p = ||HR - SR||_2 + lambda_pruned * sum ||W_P||_1 (Eq. 4). Each patch is computed with
-//      its frame's pattern (pattern_masks.h): the samplers see the whole frame (as at inference)
-//      and score the pool; the pattern is the softmax-weighted average of the pool's patterns for
-//      the first `soft_fraction` of the steps, then the chosen (argmax) pattern with the softmax
-//      gradient passed straight through, so the network trains on what inference executes.
-//      Validation (eval mode) uses the chosen patterns, i.e. measures the hybrid model exactly.
-//   3. selection_counts(): how often each pattern is chosen on a set of frames (static pruning
-//      keeps what is chosen at least once).
+//   1. hooks(): the Trainer fine-tunes the network so that every nested pattern of the pool
+//      (pattern_pool.h) works on its own, by the sandwich rule: each step trains the widest
+//      pattern (the trainer's own loss), the narrowest and `sampled_patterns` others drawn per
+//      step, each with L_p = ||HR - SR||_2 + lambda_pruned * ||W_P||_1 (Eq. 4 of the paper, W_P
+//      the weights the pattern leaves out; pattern_masks.h). The widest pattern, the static
+//      network, is itself trained.
+//   2. fit_selector(): the dynamic pruning component (the sampler, dynamic_sampler.h) learns to
+//      choose a pattern per frame from the rendering information of that frame and the one
+//      before. On every training frame each pattern's PSNR loss against the widest is measured
+//      on the full frame, and each pattern's cost: its MACs or its latency on this machine (the
+//      latency table), as a fraction of the widest pattern's. A frame's cost of pattern k is
+//      loss_dB[k] + lambda * cost[k], with lambda the smallest price for which the frames'
+//      cheapest patterns meet the budget on average: easy frames (little geometry, little
+//      motion) take narrow patterns, hard ones wide. The sampler is fitted to the softmax of -cost / temperature per frame
+//      (cross-entropy): Eq. 4's image term plus a latency term, made a distribution so that
+//      frames where patterns cost about the same do not pull hard either way.
 
 #include <map>
 #include <memory>
 #include <vector>
 
 #include "core/config.h"
+#include "core/enum_names.h"
 #include "models/sr_network.h"
 #include "pruning/dynamic_sampler.h"
 #include "pruning/pattern_masks.h"
+#include "pruning/pattern_networks.h"
 #include "pruning/pattern_pool.h"
 #include "render_data/dataset.h"
 #include "train/trainer.h"
@@ -32,14 +38,48 @@ struct FinetuneOptions {
   double epochs = 2;             // passes over the training frames' LR pixels; 0: schedule.steps
   TrainSchedule schedule;        // batch, patch size, learning rates (steps from epochs when > 0)
   LossOptions loss;              // the image term of L_p (and the RIT gate penalty)
-  double lambda_pruned = 1e-4;   // weight of sum ||W_P||_1
-  double soft_fraction = 0.5;    // fraction of the steps with soft (averaged) patterns
+  double lambda_pruned = 1e-4;   // weight of ||W_P||_1
+  int sampled_patterns = 1;      // patterns between the widest and the narrowest trained per step
   FinetuneOptions();
 };
 config::Schema<FinetuneOptions> finetune_schema();
 
 // Optimizer steps of `options` on `data`'s training frames at `scale`.
 int finetune_steps(const FinetuneOptions& options, const Dataset& data, int scale);
+
+// What a pattern costs when the choice is fitted. MACs make the choice reproducible; a latency
+// table measured on a shared machine can differ between two runs, and the choice with it.
+enum class PatternCost { Macs, Latency };
+template <>
+struct EnumNames<PatternCost> {
+  static constexpr const char* kind = "pattern cost";
+  static const std::vector<std::string>& names();  // macs, latency
+};
+
+struct SelectorOptions {
+  PatternCost cost = PatternCost::Macs;
+  double budget = 0.75;          // mean per-frame cost, as a fraction of the widest pattern's
+  double temperature = 0.02;     // dB: cost differences below this are near-ties
+  int steps = 400;               // optimizer steps (full batch of the training frames)
+  double learning_rate = 1e-2;
+  int frames = 0;                // training frames measured and fitted on (0 = all)
+  int latency_runs = 5;          // rounds of the latency table
+};
+config::Schema<SelectorOptions> selector_schema();
+
+// What fit_selector measured and chose.
+struct SelectorFit {
+  std::vector<int> frames;
+  std::vector<std::vector<double>> loss_db;  // [frame][pattern]: PSNR below the widest pattern's
+  std::vector<double> latency_ms;            // [pattern], the latency table at the frames' size
+  std::vector<double> cost;                  // [pattern], fraction of the widest pattern's
+  double price = 0;                          // lambda: dB per widest-pattern cost
+  std::vector<int> best;                     // [frame]: the pattern of least cost
+  std::vector<int> chosen;                   // [frame]: the sampler's choice after fitting
+  double agreement = 0;                      // fraction of frames where chosen == best
+  double mean_cost = 0;                      // of the chosen patterns, against the widest
+};
+nlohmann::ordered_json to_json(const SelectorFit& fit);
 
 class DynamicPruning {
  public:
@@ -50,25 +90,20 @@ class DynamicPruning {
   torch::Tensor sampler_input(int frame);
   torch::Tensor sampler_inputs(const std::vector<int>& frames);
 
-  // Fits the samplers to `assignment[i][u]` (pool entry of frames[i] for unit u); returns the
-  // fraction of (frame, unit) choices matching the assignment afterwards.
-  double warm_up(const std::vector<int>& frames, const std::vector<std::vector<int>>& assignment, int steps,
-                 double learning_rate);
+  // Trainer hooks of the sandwich fine-tuning.
+  TrainHooks hooks(const FinetuneOptions& options);
 
-  // Trainer hooks for the fine-tuning of `total_steps` steps.
-  TrainHooks hooks(const FinetuneOptions& options, int total_steps);
+  // Step 2 on `frames` with the network as it is now.
+  SelectorFit fit_selector(const std::vector<int>& frames, const SelectorOptions& options);
 
-  // [unit][pattern]: frames among `frames` choosing the pattern.
-  std::vector<std::vector<int64_t>> selection_counts(const std::vector<int>& frames);
+  // [pattern]: frames among `frames` for which the sampler chooses it.
+  std::vector<int64_t> selection_counts(const std::vector<int>& frames);
 
   SRNetwork network() const { return network_; }
   DynamicSamplers samplers() const { return samplers_; }
   const PatternPool& pool() const { return pool_; }
 
  private:
-  // Per-unit pattern weights [N, K_u] for a batch of sampler inputs (see the header comment).
-  std::vector<torch::Tensor> pattern_weights(const torch::Tensor& input, bool soft, bool training);
-
   SRNetwork network_;
   const Dataset& data_;
   PatternPool pool_;
@@ -76,7 +111,6 @@ class DynamicPruning {
   std::vector<RenderChannel> channels_;
   std::unique_ptr<PatternMasks> masks_;
   std::map<int, torch::Tensor> inputs_;
-  std::map<std::string, torch::Tensor> last_masks_;  // of the last training forward, for the penalty
 };
 
 }  // namespace cgsr

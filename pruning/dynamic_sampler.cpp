@@ -52,7 +52,15 @@ torch::Tensor sampler_input(const torch::Tensor& info, const torch::Tensor& prev
     offset += channel_width(ch);
   }
   const auto pool = [&](const torch::Tensor& x) {
-    return torch::adaptive_avg_pool2d(x.to(torch::kFloat) * scale, {grid, grid});
+    auto scaled = x.to(torch::kFloat) * scale;
+    // A pixel moving more than a frame width left the view: renderers report such motion
+    // (disoccluded or far geometry) with huge values that would swamp the average.
+    int64_t at = 0;
+    for (auto ch : channels) {
+      if (ch == RenderChannel::Motion) scaled.slice(1, at, at + 2).clamp_(-1.0, 1.0);
+      at += channel_width(ch);
+    }
+    return torch::adaptive_avg_pool2d(scaled, {grid, grid});
   };
   const auto current = pool(info);
   const auto change = previous.defined() ? current - pool(previous) : torch::zeros_like(current);

@@ -1,17 +1,16 @@
 #pragma once
-// The dynamic samplers of the dynamic pruning components (DPC, Fig. 4 of the paper): per
-// pruning unit, a few pooling and convolution layers over the rendering information of the
-// current and the previous frame that score the unit's pattern pool. A softmax over the scores
-// gives the learned weighted average of the pool's patterns, the unit's regularizing pattern
-// during fine-tuning; at inference the highest score picks the pattern for the frame.
+// The sampler of the dynamic pruning component (DPC, Fig. 4 of the paper): a few pooling and
+// convolution layers over the rendering information of the current and the previous frame that
+// score patterns. A hybrid-pruned model has one head scoring the pool's nested patterns
+// (dynamic_pruning.h); the layers support U heads of K_u patterns each (grouped convolutions).
 //
 //   input  [N, 2C, g, g]: the chosen rendering channels of the current frame, average-pooled to
 //          a g x g grid, and their change since the previous frame (sampler_input)
-//   conv 3x3 (2C -> U*w), ReLU, 2x2 average pooling        one w-channel slice per unit
-//   conv 3x3 (U*w -> U*w, U groups), ReLU, global average  each unit sees only its slice
-//   conv 1x1 (U*w -> U*K, U groups)                       scores of the unit's K patterns
-// The units share the input and run as three grouped convolutions, so scoring every unit of a
-// frame costs three small kernels (about 1 MMAC at g = 16), whatever the frame size.
+//   conv 3x3 (2C -> U*w), ReLU, 2x2 average pooling        one w-channel slice per head
+//   conv 3x3 (U*w -> U*w, U groups), ReLU, global average  each head sees only its slice
+//   conv 1x1 (U*w -> U*K, U groups)                       scores of the head's K patterns
+// Scoring a frame costs three small kernels (well under 1 MMAC at g = 16), whatever the frame
+// size.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/conv.h>
@@ -35,7 +34,7 @@ config::Schema<SamplerOptions> sampler_schema();
 
 // The sampler input from the rendering information (`channels`, [N, C, H, W]) of the current and
 // the previous frame (undefined: no previous frame, the change is zero). Motion is divided by
-// the frame size so the input does not depend on the resolution.
+// the frame size so the input does not depend on the resolution, and clamped to one frame.
 torch::Tensor sampler_input(const torch::Tensor& info, const torch::Tensor& previous,
                             const std::vector<RenderChannel>& channels, int grid);
 

@@ -2,6 +2,7 @@
 
 #include <torch/torch.h>
 
+#include <cmath>
 #include <set>
 
 #include "core/error.h"
@@ -11,7 +12,7 @@ namespace cgsr {
 
 namespace {
 constexpr const char* kKey = "dynamic_pruning";
-constexpr int kFormat = 1;
+constexpr int kFormat = 2;
 const std::string kPrefix = std::string(kExtraTensorPrefix) + "dpc.";
 }  // namespace
 
@@ -28,8 +29,9 @@ void save_hybrid_model(const std::filesystem::path& path, const HybridModel& mod
                                      {"sampler", {{"channels", options.channels},
                                                   {"grid", options.grid},
                                                   {"width", options.width}}},
-                                     {"patterns", model.samplers->patterns()},
-                                     {"pool", to_json(model.pool)}};
+                                     {"pool", to_json(model.pool)},
+                                     {"latency", {{"lr_size", {model.latency.lr_width, model.latency.lr_height}},
+                                                  {"median_ms", model.latency.median_ms}}}};
   for (const auto& p : model.network->named_parameters(/*recurse=*/true)) contents.tensors.emplace_back(p.key(), p.value());
   for (const auto& p : model.samplers->named_parameters(/*recurse=*/true))
     contents.tensors.emplace_back(kPrefix + p.key(), p.value());
@@ -48,14 +50,17 @@ HybridModel load_hybrid_model(const std::filesystem::path& path) {
   model.provenance = base.provenance;
   const auto& j = base.provenance.extra[kKey];
   SamplerOptions options;
-  std::vector<int> patterns;
   try {
     if (j.at("format").get<int>() != kFormat)
-      throw Error(where, "dynamic pruning data format " + j.at("format").dump() + " is not supported");
+      throw Error(where, "dynamic pruning data format " + j.at("format").dump() + " is not supported (this cgsr reads format " +
+                             std::to_string(kFormat) + ": run cgsr prune again)");
     options.channels = j.at("sampler").at("channels").get<std::vector<std::string>>();
     options.grid = j.at("sampler").at("grid").get<int>();
     options.width = j.at("sampler").at("width").get<int>();
-    patterns = j.at("patterns").get<std::vector<int>>();
+    const auto& latency = j.at("latency");
+    model.latency.lr_width = latency.at("lr_size").at(0).get<int64_t>();
+    model.latency.lr_height = latency.at("lr_size").at(1).get<int64_t>();
+    model.latency.median_ms = latency.at("median_ms").get<std::vector<double>>();
   } catch (const nlohmann::json::exception& e) {
     throw Error(where, std::string("malformed dynamic pruning data: ") + e.what());
   }
@@ -67,15 +72,12 @@ HybridModel load_hybrid_model(const std::filesystem::path& path) {
   if (options.grid < 2 || options.width < 1) throw Error(where, "invalid dynamic sampler settings");
   const auto units = find_units(model.network->describe(false));
   model.pool = pool_from_json(j.at("pool"), units, where);
-  if (patterns.size() != model.pool.units.size())
-    throw Error(where, "dynamic samplers for " + std::to_string(patterns.size()) + " units, the pool has " +
-                           std::to_string(model.pool.units.size()));
-  for (size_t u = 0; u < patterns.size(); ++u)
-    if (patterns[u] != static_cast<int>(model.pool.units[u].patterns.size()))
-      throw Error(where, "the sampler of unit " + model.pool.units[u].unit.name + " scores " +
-                             std::to_string(patterns[u]) + " patterns, the pool holds " +
-                             std::to_string(model.pool.units[u].patterns.size()));
-  model.samplers = DynamicSamplers(options, patterns);
+  if (model.latency.median_ms.size() != static_cast<size_t>(model.pool.size()))
+    throw Error(where, "the latency table has " + std::to_string(model.latency.median_ms.size()) +
+                           " entries, the pool " + std::to_string(model.pool.size()) + " patterns");
+  for (double ms : model.latency.median_ms)
+    if (!std::isfinite(ms) || ms < 0) throw Error(where, "the latency table holds an invalid time");
+  model.samplers = DynamicSamplers(options, std::vector<int>{model.pool.size()});
   auto params = model.samplers->named_parameters(/*recurse=*/true);
   std::set<std::string> seen;
   torch::NoGradGuard no_grad;

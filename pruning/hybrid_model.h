@@ -1,10 +1,11 @@
 #pragma once
-// A hybrid-pruned model: the statically pruned network plus its dynamic pruning components
-// (the samplers and the pattern pool), in one model file.
+// A hybrid-pruned model: the statically pruned network plus its dynamic pruning component (the
+// sampler and the pool of nested patterns) and the patterns' latency table, in one model file.
 //
 // The file is an ordinary model file (models/model_file.h): the network's parameters under their
 // usual names, the samplers' tensors under "extra.dpc.", and the pool and sampler settings in
-// provenance.extra["dynamic_pruning"]. load_model() therefore reads the static network alone
+// provenance.extra["dynamic_pruning"] (format 2; format 1, per-unit pattern pools of equal cost,
+// is no longer read). load_model() therefore reads the static network alone
 // (export, bench and eval of the static part work unchanged); load_hybrid_model() reads all.
 
 #include <filesystem>
@@ -17,10 +18,17 @@
 
 namespace cgsr {
 
+// Each pattern's latency on the machine that pruned the model, at one input size.
+struct LatencyTable {
+  int64_t lr_width = 0, lr_height = 0;
+  std::vector<double> median_ms;  // [pattern]
+};
+
 struct HybridModel {
-  SRNetwork network{nullptr};  // statically pruned; runs dense on its own
-  PatternPool pool;            // in the network's channel indices
-  DynamicSamplers samplers{nullptr};
+  SRNetwork network{nullptr};  // statically pruned (the widest pattern); runs dense on its own
+  PatternPool pool;            // nested patterns of the network
+  DynamicSamplers samplers{nullptr};  // one head scoring the pool's patterns
+  LatencyTable latency;
   Provenance provenance;
 };
 

@@ -3,11 +3,11 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.h"
 
 namespace cgsr {
-
 
 HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std::move(name)), model_(std::move(model)) {
   model_.network->eval();
@@ -17,7 +17,8 @@ HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std:
   for (auto c : sampler_channels_)
     if (std::find(channels_.begin(), channels_.end(), c) == channels_.end()) channels_.push_back(c);
   std::sort(channels_.begin(), channels_.end());
-  executor_ = std::make_unique<PatternExecutor>(*model_.network, model_.pool);
+  patterns_ = std::make_unique<PatternNetworks>(*model_.network, model_.pool);
+  usage_.assign(model_.pool.size(), 0);
 }
 
 torch::Tensor HybridUpscaler::sampler_info(const Batch& batch) const {
@@ -29,7 +30,7 @@ void HybridUpscaler::previous_frame(const Batch& previous) {
   previous_frame_ = previous.frames.empty() ? -1 : previous.frames.front();
 }
 
-std::vector<int> HybridUpscaler::choose(const Batch& batch) {
+int HybridUpscaler::choose(const Batch& batch) {
   if (batch.lr_color.size(0) != 1)
     throw Error("hybrid-pruned model", "chooses patterns per frame: give one frame at a time, got a batch of " +
                                            std::to_string(batch.lr_color.size(0)));
@@ -50,7 +51,7 @@ std::vector<int> HybridUpscaler::choose(const Batch& batch) {
     has_previous = false;
   }
   const auto input = sampler_input(info, previous, sampler_channels_, model_.samplers->options().grid);
-  const auto choice = model_.samplers->choose(input).front();
+  const int choice = model_.samplers->choose(input).front().front();
   previous_info_ = torch::Tensor();
   previous_frame_ = -1;
   last_info_ = info;
@@ -61,33 +62,34 @@ std::vector<int> HybridUpscaler::choose(const Batch& batch) {
 
 torch::Tensor HybridUpscaler::upscale(const Batch& batch) {
   const auto start = std::chrono::steady_clock::now();
-  const auto choice = choose(batch);
+  const int k = choose(batch);
   const double choose_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  const auto out = executor_->run(batch.lr_color, model_.network->info_input(batch), choice);
-  auto patterns = nlohmann::ordered_json::object();
-  for (size_t u = 0; u < choice.size(); ++u) patterns[model_.pool.units[u].unit.name] = choice[u];
-  details_["patterns"] = patterns;
+  const auto out = patterns_->run(k, batch.lr_color, model_.network->info_input(batch));
+  ++usage_[k];
+  details_["pattern"] = k;
+  details_["channel_fraction"] = model_.pool.channel_fraction(k);
   details_["choose_ms"] = choose_ms;
   return out;
 }
 
 std::optional<Complexity> HybridUpscaler::cost(int64_t lr_width, int64_t lr_height) const {
-  // MACs: what one frame executes. Every pattern of a unit keeps the same channel counts, so
-  // any choice costs the same; count the first. Params: what the model holds, i.e. the static
-  // network (the union of its patterns). The samplers add to both (their MACs do not depend on
-  // the frame size).
-  const graph::Graph g = model_.network->describe(false);
-  const std::vector<int> first(model_.pool.units.size(), 0);
-  Complexity c = complexity(select_channels(g, model_.pool.selection(first)), lr_width, lr_height);
-  c.params = complexity(g, lr_width, lr_height).params;
-  LayerCost samplers;
-  samplers.name = "dynamic_samplers";
-  samplers.kind = "dynamic_sampler";
-  samplers.params = model_.samplers->parameter_count();
-  samplers.macs = model_.samplers->macs();
-  c.layers.push_back(samplers);
-  c.params += samplers.params;
-  c.macs += samplers.macs;
+  int64_t frames = 0;
+  for (int64_t n : usage_) frames += n;
+  Complexity c = patterns_->cost(0, lr_width, lr_height);
+  if (frames > 0) {
+    double macs = 0;
+    for (int k = 0; k < model_.pool.size(); ++k)
+      if (usage_[k] > 0) macs += static_cast<double>(usage_[k]) * static_cast<double>(patterns_->cost(k, lr_width, lr_height).macs);
+    c.macs = static_cast<int64_t>(std::llround(macs / static_cast<double>(frames)));
+  }
+  LayerCost sampler;
+  sampler.name = "dynamic_sampler";
+  sampler.kind = "dynamic_sampler";
+  sampler.params = model_.samplers->parameter_count();
+  sampler.macs = model_.samplers->macs();
+  c.layers.push_back(sampler);
+  c.params += sampler.params;
+  c.macs += sampler.macs;
   return c;
 }
 

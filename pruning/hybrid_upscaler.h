@@ -1,9 +1,9 @@
 #pragma once
-// A hybrid-pruned model as an Upscaler: per frame, the dynamic samplers score each unit's
-// patterns from the current and previous frame's rendering information, the best pattern of
-// every unit is chosen, and the statically pruned network runs with those patterns as smaller
-// dense convolutions (pattern_executor.h). `cgsr eval` runs it through the same evaluation as
-// every other upscaler; frame_details() records the choice and the time spent choosing.
+// A hybrid-pruned model as an Upscaler: per frame, the dynamic pruning component scores the
+// pool's patterns from the current and previous frame's rendering information, and the chosen
+// pattern runs as its own narrow network on cgsr's fast path (pattern_networks.h). `cgsr eval`
+// runs it through the same evaluation as every other upscaler; frame_details() records the
+// choice and the time spent choosing.
 //
 // The previous frame is the one given to previous_frame(), else the frame of the last
 // upscale() call when it is the frame just before (a renderer calling it frame after frame),
@@ -13,7 +13,7 @@
 #include <memory>
 
 #include "pruning/hybrid_model.h"
-#include "pruning/pattern_executor.h"
+#include "pruning/pattern_networks.h"
 #include "train/upscaler.h"
 
 namespace cgsr {
@@ -27,14 +27,18 @@ class HybridUpscaler : public Upscaler {
   std::vector<RenderChannel> channels() const override { return channels_; }
   DepthEncoding depth_encoding() const override { return model_.network->depth_encoding(); }
   torch::Tensor upscale(const Batch& batch) override;
+  // MACs: the mean over the frames upscaled so far (the widest pattern's before any); params:
+  // what the model holds (the static network and the sampler).
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   bool uses_previous_frame() const override { return true; }
   void previous_frame(const Batch& previous) override;
   nlohmann::ordered_json frame_details() const override { return details_; }
 
-  // The patterns chosen for a frame (one index per unit) from its rendering information.
-  std::vector<int> choose(const Batch& batch);
+  // The pattern chosen for a frame from its rendering information.
+  int choose(const Batch& batch);
   const HybridModel& model() const { return model_; }
+  // Frames per pattern among those upscaled so far.
+  const std::vector<int64_t>& usage() const { return usage_; }
 
  private:
   torch::Tensor sampler_info(const Batch& batch) const;
@@ -42,7 +46,8 @@ class HybridUpscaler : public Upscaler {
   std::string name_;
   HybridModel model_;
   std::vector<RenderChannel> sampler_channels_, channels_;
-  std::unique_ptr<PatternExecutor> executor_;
+  std::unique_ptr<PatternNetworks> patterns_;
+  std::vector<int64_t> usage_;
   torch::Tensor previous_info_;   // sampler channels of the previous frame
   int previous_frame_ = -1;       // its frame index (-1: none)
   int last_frame_ = -1;           // frame of the last upscale()

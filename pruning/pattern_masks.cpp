@@ -9,33 +9,27 @@ namespace cgsr {
 
 PatternMasks::PatternMasks(const SRNetworkImpl& net, const PatternPool& pool)
     : graph_(net.describe(false)), pool_(pool) {
-  std::vector<PrunableUnit> units;
-  for (const auto& u : pool_.units) units.push_back(u.unit);
   masked_.assign(graph_.ops.size(), false);
-  for (size_t i : conv_input_producers(graph_, units)) masked_[i] = true;
-  for (const auto& u : pool_.units) {
-    std::vector<torch::Tensor> per_group;
-    for (size_t g = 0; g < u.unit.groups.size(); ++g) {
-      auto p = torch::zeros({static_cast<int64_t>(u.patterns.size()), u.unit.widths[g]});
-      for (size_t k = 0; k < u.patterns.size(); ++k)
-        for (int64_t c : u.patterns[k].keep.at(u.unit.groups[g])) p[k][c] = 1.0f;
-      per_group.push_back(p);
+  for (size_t i : conv_input_producers(graph_, pool_.units)) masked_[i] = true;
+  for (const auto& u : pool_.units)
+    for (size_t g = 0; g < u.groups.size(); ++g) {
+      auto p = torch::zeros({pool_.size(), u.widths[g]});
+      for (int k = 0; k < pool_.size(); ++k) p[k].slice(0, 0, pool_.widths[k].at(u.groups[g])).fill_(1.0f);
+      patterns_[u.groups[g]] = p;
     }
-    patterns_.push_back(per_group);
-  }
 }
 
-std::map<std::string, torch::Tensor> PatternMasks::group_masks(const std::vector<torch::Tensor>& unit_weights) const {
-  CGSR_CHECK(unit_weights.size() == pool_.units.size(), "pattern masks: one weight tensor per unit");
+std::map<std::string, torch::Tensor> PatternMasks::group_masks(const torch::Tensor& pattern_weights) const {
+  CGSR_CHECK(pattern_weights.dim() == 2 && pattern_weights.size(1) == pool_.size(),
+             "pattern masks: pattern weights must be [N, K]");
   std::map<std::string, torch::Tensor> out;
-  for (size_t u = 0; u < pool_.units.size(); ++u) {
-    const auto& w = unit_weights[u];
-    CGSR_CHECK(w.dim() == 2 && w.size(1) == static_cast<int64_t>(pool_.units[u].patterns.size()),
-               "pattern masks: weights of unit " + pool_.units[u].unit.name + " must be [N, K]");
-    for (size_t g = 0; g < pool_.units[u].unit.groups.size(); ++g)
-      out[pool_.units[u].unit.groups[g]] = w.matmul(patterns_[u][g]);
-  }
+  for (const auto& [group, p] : patterns_) out[group] = pattern_weights.matmul(p);
   return out;
+}
+
+std::map<std::string, torch::Tensor> PatternMasks::group_masks(int pattern, int64_t n) const {
+  CGSR_CHECK(pattern >= 0 && pattern < pool_.size(), "pattern masks: pattern index out of range");
+  return group_masks(torch::one_hot(torch::full({n}, pattern, torch::kLong), pool_.size()).to(torch::kFloat));
 }
 
 torch::Tensor PatternMasks::forward(const torch::Tensor& lr_color, const torch::Tensor& info,
@@ -64,7 +58,7 @@ torch::Tensor PatternMasks::forward(const torch::Tensor& lr_color, const torch::
 std::map<std::string, torch::Tensor> PatternMasks::attached_l1() const {
   std::map<std::string, torch::Tensor> out;
   for (const auto& u : pool_.units)
-    for (size_t g = 0; g < u.unit.groups.size(); ++g) out[u.unit.groups[g]] = torch::zeros({u.unit.widths[g]});
+    for (size_t g = 0; g < u.groups.size(); ++g) out[u.groups[g]] = torch::zeros({u.widths[g]});
   // Adds a per-position norm along an axis to the channels of the unit groups in its layout.
   const auto accumulate = [&](const torch::Tensor& per_position, const graph::Layout& layout) {
     int64_t offset = 0;
@@ -77,7 +71,7 @@ std::map<std::string, torch::Tensor> PatternMasks::attached_l1() const {
     }
   };
   for (const auto& u : pool_.units)
-    for (size_t index : u.unit.ops) {
+    for (size_t index : u.ops) {
       const auto& op = graph_.ops[index];
       if (op.kind == graph::OpKind::Conv) {
         auto rows = op.weight.abs().sum({1, 2, 3});

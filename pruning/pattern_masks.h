@@ -1,18 +1,18 @@
 #pragma once
-// Per-sample regularizing patterns during fine-tuning (Eq. 3-4 of the paper).
+// Patterns of a pool (pattern_pool.h) applied to the dense network per sample, differentiably:
+// how every pattern is trained (dynamic_pruning.h) before it runs as a smaller network.
 //
-// A unit's pattern for one sample is a weighted average of its pool's patterns (the weights come
-// from the dynamic sampler: a softmax, or a one-hot choice): a value in [0, 1] per channel of
-// each of its groups. Multiplying a layer's weights by the pattern along its input channels,
-// W (.) m, equals scaling those input channels by m before the layer, so with per-sample patterns
-// the masked network is run as the dense network with the values that feed convolutions scaled
-// per sample and channel (the values activation_importance.h reads). With one-hot weights this
-// is exactly the network executed with that pattern (pattern_executor.h): a removed channel then
-// contributes nothing to any convolution, and pruning-unit channels never reach a residual sum.
+// A sample's pattern weights [K] (a one-hot choice, or any mix) give each channel of each unit
+// group a value in [0, 1]: the weighted sum of the patterns keeping it. Multiplying a layer's
+// weights by it along their input channels, W (.) m, equals scaling those channels by m before
+// the layer, so the masked network is run as the dense network with the values that feed
+// convolutions scaled per sample and channel (the values activation_importance.h reads). With a
+// one-hot choice this is exactly the narrow network of that pattern: a removed channel
+// contributes nothing to any convolution, and unit channels never reach a residual sum.
 //
-// The weights the patterns mark less important, W_P in Eq. 4, are those attached to a channel
-// (the rows writing it and the columns reading it) in proportion to 1 - m: their L1 norm is the
-// pruning penalty.
+// The weights a pattern leaves out, W_P in Eq. 4 of the paper, are those attached to a removed
+// channel (the rows writing it and the columns reading it), in proportion to 1 - m: their L1
+// norm is the pruning penalty.
 
 #include <torch/types.h>
 
@@ -31,8 +31,10 @@ class PatternMasks {
   // The graph holds `net`'s own parameters (gradients reach them); `net` must outlive this.
   PatternMasks(const SRNetworkImpl& net, const PatternPool& pool);
 
-  // Per group, the sample patterns [N, width] from per-unit pattern weights [N, K_u].
-  std::map<std::string, torch::Tensor> group_masks(const std::vector<torch::Tensor>& unit_weights) const;
+  // Per group, the sample masks [N, width] from pattern weights [N, K].
+  std::map<std::string, torch::Tensor> group_masks(const torch::Tensor& pattern_weights) const;
+  // The same for one pattern for every one of `n` samples.
+  std::map<std::string, torch::Tensor> group_masks(int pattern, int64_t n) const;
 
   // The network output with the masks applied (differentiable in weights and masks).
   torch::Tensor forward(const torch::Tensor& lr_color, const torch::Tensor& info,
@@ -47,7 +49,7 @@ class PatternMasks {
  private:
   graph::Graph graph_;
   const PatternPool& pool_;
-  std::vector<std::vector<torch::Tensor>> patterns_;  // [unit][group]: [K_u, width] of 0/1
+  std::map<std::string, torch::Tensor> patterns_;  // group -> [K, width] of 0/1
   std::vector<bool> masked_;                          // per op: its output feeds a conv and carries unit channels
 };
 

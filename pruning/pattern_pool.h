@@ -1,22 +1,17 @@
 #pragma once
-// The pattern pool: per pruning unit, the channel patterns most often important on the training
-// frames, found by frequency-based sorting.
+// The pattern pool of a hybrid-pruned network: K nested patterns that differ in cost, from the
+// widest (k = 0) to the narrowest (k = K - 1). Pattern k keeps, of every layer group of every
+// pruning unit (prunable_units.h), the first widths[k][group] channels.
 //
-// For every frame, each group of a unit ranks its channels by their importance under that frame
-// (activation_importance.h) and keeps the top kept_count(width, keep_rate): the frame's pattern.
-// Exact repeats of a pattern are rare when a group has tens of channels, so near-identical
-// patterns are merged. The rule, applied per unit until `size` patterns are found or every frame
-// is covered:
-//   1. d(p, q) = number of channels kept by p and not by q (patterns keep the same count per
-//      group, so d is symmetric); two patterns are near-identical when
-//      d <= floor(merge_tolerance * channels a pattern keeps). merge_tolerance 0 = exact matches.
-//   2. Among the frames not yet covered, take the frame pattern with the most near-identical
-//      frame patterns (ties: more exact repeats, then the earlier frame).
-//   3. The pool entry is the consensus of that cluster: per group, the channels selected most
-//      often by its frames (ties: higher summed importance, then lower index). Its frequency is
-//      the cluster's size. Mark the cluster's frames covered.
-// Finally every frame is assigned the pool entry nearest to its own pattern (ties: the more
-// frequent entry); the assignment is what the dynamic samplers first learn to predict.
+// "The first channels" means something because the network's channels are reordered by
+// importance once (order_channels): channel 0 of a group matters most on the training frames.
+// A pattern's weights are then leading slices of the widest weights (views, no gather), a
+// narrower pattern keeps a subset of every wider one's channels, and the widest pattern is the
+// network itself: the static network that hybrid pruning ships is a pattern that was trained.
+//
+//   Inheritance ordered = order_channels(*net, units, importance);   // same outputs, sorted channels
+//   PatternPool pool = nested_pool(find_units(ordered.network->describe(false)), {1.0, 0.7, 0.5});
+//   graph::Graph narrow = select_channels(ordered.network->describe(false), pool.selection(2));
 
 #include <cstdint>
 #include <map>
@@ -27,51 +22,50 @@
 #include <torch/types.h>
 
 #include "core/config.h"
+#include "models/inherit.h"
+#include "models/sr_network.h"
 #include "pruning/channel_selection.h"
 #include "pruning/prunable_units.h"
 
 namespace cgsr {
 
 struct PoolOptions {
-  double keep_rate = 0.5;         // fraction of each group's channels a pattern keeps
-  int size = 8;                   // patterns per unit (K)
-  double merge_tolerance = 0.25;  // see the rule above
+  // Pattern k keeps kept_count(width, keep_rates[k]) channels of every unit group. Strictly
+  // decreasing; the first is usually 1 (the static network keeps every channel it was given).
+  std::vector<double> keep_rates = {1.0, 0.75, 0.5, 0.35};
 };
 config::Schema<PoolOptions> pool_schema();
 
-struct Pattern {
-  ChannelSelection keep;  // every group of the unit, kept channel indices
-  int frames = 0;         // frames whose pattern this entry stands for
-};
-
-struct UnitPatterns {
-  PrunableUnit unit;
-  std::vector<Pattern> patterns;  // most frequent first
-};
-
 struct PatternPool {
-  std::vector<UnitPatterns> units;
+  std::vector<PrunableUnit> units;                      // of the network the pool belongs to
+  std::vector<std::map<std::string, int64_t>> widths;   // [pattern][group] -> channels kept (a prefix)
 
-  // The channels a choice (one pattern index per unit) keeps, for every unit group.
-  ChannelSelection selection(const std::vector<int>& choice) const;
-  // Per unit group, the union of every pattern's channels.
-  ChannelSelection union_selection() const;
-  int max_patterns() const;
+  int size() const { return static_cast<int>(widths.size()); }
+  // The channels pattern k keeps: {group: 0, 1, ..., widths[k][group] - 1}.
+  ChannelSelection selection(int k) const;
+  // The fraction of the unit channels pattern k keeps (summed over groups).
+  double channel_fraction(int k) const;
 };
+
+// The pool of nested patterns over `units` (widest first); rates must be strictly decreasing in
+// (0, 1], and no two patterns may keep the same channels.
+PatternPool nested_pool(const std::vector<PrunableUnit>& units, const std::vector<double>& keep_rates);
+
+// The pool restricted to `kept` patterns (indices, increasing), in the network that keeps the
+// widest of them: what static pruning leaves when some patterns are never chosen.
+PatternPool keep_patterns(const PatternPool& pool, const std::vector<int>& kept,
+                          const std::vector<PrunableUnit>& narrowed_units);
 
 // Per frame: layer group -> channel importance [width] (CPU float).
 using FrameImportance = std::map<std::string, torch::Tensor>;
 
-struct PoolBuild {
-  PatternPool pool;
-  std::vector<std::vector<int>> assignment;  // [frame][unit] -> pattern index
-};
+// Per group of `units`: channel indices by decreasing importance, each frame's importance
+// normalized to sum 1 first so that every frame counts alike (ties: the lower index first).
+ChannelSelection importance_order(const std::vector<PrunableUnit>& units, const std::vector<FrameImportance>& frames);
 
-PoolBuild build_pattern_pool(const std::vector<PrunableUnit>& units, const std::vector<FrameImportance>& frames,
-                             const PoolOptions& options);
-
-// The top kept_count(width, keep_rate) channels of each group of `unit` (sorted indices).
-ChannelSelection top_channels(const PrunableUnit& unit, const FrameImportance& importance, double keep_rate);
+// The same network with every unit group's channels permuted into `order` (a permutation per
+// group): it computes the same outputs (up to float summation order).
+Inheritance order_channels(const SRNetworkImpl& net, const ChannelSelection& order);
 
 nlohmann::ordered_json to_json(const PatternPool& pool);
 // `units` are those of the network the pool belongs to (find_units of its graph); the JSON must

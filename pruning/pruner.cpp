@@ -9,6 +9,7 @@
 #include "pruning/activation_importance.h"
 #include "pruning/hybrid_upscaler.h"
 #include "pruning/magnitude_pruning.h"
+#include "pruning/pattern_networks.h"
 #include "render_data/patch_sampler.h"
 
 namespace cgsr {
@@ -34,6 +35,45 @@ nlohmann::ordered_json against(const EvalResult& r, const EvalResult& base) {
   j["ssim_delta"] = r.ssim - base.ssim;
   return j;
 }
+
+// Step 1: the input network with its unit channels in order of importance on `frames`, and the
+// pool of nested patterns over it.
+std::pair<SRNetwork, PatternPool> ordered_network(SRNetworkImpl& net, const Dataset& data, const std::vector<int>& frames,
+                                                  const PruneOptions& options) {
+  const int scale = net.spec().scale;
+  const auto units = find_units(net.describe(false));
+  const auto method = enum_from_name<ImportanceMethod>(options.importance);
+  std::vector<FrameImportance> importance;
+  Progress progress("importance", static_cast<int64_t>(frames.size()));
+  for (int f : frames) {
+    importance.push_back(
+        frame_importance(net, frame_batch(data, f, scale, net.input_channels(), net.depth_encoding()), units, method));
+    progress.advance();
+  }
+  progress.finish();
+  SRNetwork ordered = order_channels(net, importance_order(units, importance)).network;
+  PatternPool pool = nested_pool(find_units(ordered->describe(false)), options.pool.keep_rates);
+  return {ordered, pool};
+}
+
+// Step 4: static pruning and the hybrid model with its latency table.
+HybridModel hybrid_model(DynamicPruning& dynamic, const std::vector<int64_t>& counts, const Dataset& data, int frame,
+                         const PruneOptions& options, StaticPruning& pruned) {
+  pruned = static_prune(*dynamic.network(), dynamic.pool(), counts, options.static_prune);
+  HybridModel hybrid;
+  hybrid.network = pruned.network;
+  hybrid.pool = pruned.pool;
+  hybrid.samplers = dynamic.samplers();
+  hybrid.samplers->keep_patterns({pruned.kept});
+  PatternNetworks patterns(*hybrid.network, hybrid.pool);
+  const Batch b = frame_batch(data, frame, hybrid.network->spec().scale, hybrid.network->input_channels(),
+                              hybrid.network->depth_encoding());
+  hybrid.latency.lr_width = b.lr_color.size(3);
+  hybrid.latency.lr_height = b.lr_color.size(2);
+  for (const auto& l : patterns.measure_latency(b.lr_color, hybrid.network->info_input(b), options.selector.latency_runs))
+    hybrid.latency.median_ms.push_back(l.median_ms);
+  return hybrid;
+}
 }  // namespace
 
 nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Dataset& data, const PruneOptions& options,
@@ -43,50 +83,38 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   Model input = load_model(model_path);
   const std::string name =
       options.name.empty() ? input.provenance.extra.value("name", model_path.stem().string()) : options.name;
-  SRNetwork net = input.network;
-  const int scale = net->spec().scale;
-  const auto units = find_units(net->describe(false));
-  if (units.empty()) throw Error(where, "the network has no layer groups that can be pruned per frame");
+  const int scale = input.network->spec().scale;
+  if (find_units(input.network->describe(false)).empty())
+    throw Error(where, "the network has no layer groups that can be pruned per frame");
   const auto train_frames = data.frames(Split::Train);
   if (train_frames.empty()) throw Error(data.info().root.string(), "the data set has no training frames");
-  spdlog::info("pruning {} ({}): {} units, keep rate {}, pool of {} per unit", name, spec_summary(net->spec()),
-               units.size(), options.pool.keep_rate, options.pool.size);
+  spdlog::info("pruning {} ({}): {} patterns of keep rates {}", name, spec_summary(input.network->spec()),
+               options.pool.keep_rates.size(), nlohmann::json(options.pool.keep_rates).dump());
 
-  // 1-2. Per-frame importance, then the pattern pool.
+  // 1. Channels in order of importance, nested patterns.
   const auto pool_frames = spread(train_frames, options.pool_frames);
-  const auto method = enum_from_name<ImportanceMethod>(options.importance);
-  std::vector<FrameImportance> importance;
-  {
-    Progress progress("importance", static_cast<int64_t>(pool_frames.size()));
-    for (int f : pool_frames) {
-      importance.push_back(frame_importance(*net, frame_batch(data, f, scale, net->input_channels(), net->depth_encoding()), units, method));
-      progress.advance();
-    }
-    progress.finish();
-  }
-  const PoolBuild build = build_pattern_pool(units, importance, options.pool);
-  write_file_atomic(out / "pool.json", to_json(build.pool).dump(1));
+  auto [net, pool] = ordered_network(*input.network, data, pool_frames, options);
+  write_file_atomic(out / "pool.json", to_json(pool).dump(1));
 
-  // 3. Dynamic samplers: warm-up, then fine-tuning of network and samplers with L_p.
-  DynamicPruning dynamic(net, data, build.pool, options.sampler);
-  const double warmup_accuracy =
-      dynamic.warm_up(pool_frames, build.assignment, options.warmup_steps, options.warmup_lr);
-  spdlog::info("samplers warmed up: {:.1f}% of the frames' pool entries predicted", 100 * warmup_accuracy);
+  // 2. Every pattern fine-tuned (sandwich rule).
+  DynamicPruning dynamic(net, data, pool, options.sampler);
   TrainSchedule schedule = options.finetune.schedule;
   schedule.steps = finetune_steps(options.finetune, data, scale);
-  spdlog::info("fine-tuning with dynamic patterns: {} steps ({} epochs)", schedule.steps, options.finetune.epochs);
-  Trainer finetune(net, data, schedule, options.finetune.loss, {}, dynamic.hooks(options.finetune, schedule.steps));
+  spdlog::info("fine-tuning {} nested patterns: {} steps ({} epochs)", pool.size(), schedule.steps,
+               options.finetune.epochs);
+  Trainer finetune(net, data, schedule, options.finetune.loss, {}, dynamic.hooks(options.finetune));
   const TrainOutcome hybrid_training = finetune.run(out / "finetune_hybrid.pt", resume);
+
+  // 3. The per-frame choice.
+  const SelectorFit fit = dynamic.fit_selector(spread(train_frames, options.selector.frames), options.selector);
+  spdlog::info("pattern choice fitted: mean cost {:.3f} of the widest (budget {}), {:.0f}% of the frames' cheapest "
+               "patterns chosen",
+               fit.mean_cost, options.selector.budget, 100 * fit.agreement);
 
   // 4. Static pruning of what no training frame selects.
   const auto counts = dynamic.selection_counts(train_frames);
-  StaticPruning pruned = static_prune(*net, dynamic.pool(), counts, options.static_prune);
-  DynamicSamplers samplers = dynamic.samplers();
-  samplers->keep_patterns(pruned.kept);
-  HybridModel hybrid;
-  hybrid.network = pruned.network;
-  hybrid.pool = pruned.pool;
-  hybrid.samplers = samplers;
+  StaticPruning pruned;
+  HybridModel hybrid = hybrid_model(dynamic, counts, data, train_frames.front(), options, pruned);
   hybrid.provenance.stage = "pruned";
   hybrid.provenance.parent = where;
   hybrid.provenance.config = config;
@@ -96,37 +124,45 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   const auto hybrid_path = out / "pruned.cgsr";
   save_hybrid_model(hybrid_path, hybrid);
 
+  // Mean MACs of the hybrid model's choices on the training frames.
+  const Resolution lr = data.resolutions()[resolution_pair(data, scale).first];
+  PatternNetworks static_patterns(*hybrid.network, hybrid.pool);
+  double mean_macs = 0;
+  int64_t chosen = 0;
+  for (size_t i = 0; i < pruned.kept.size(); ++i) {
+    const int64_t n = counts[pruned.kept[i]];
+    mean_macs += static_cast<double>(n) * static_cast<double>(static_patterns.cost(static_cast<int>(i), lr.width, lr.height).macs);
+    chosen += n;
+  }
+  mean_macs /= static_cast<double>(std::max<int64_t>(1, chosen));
+
   nlohmann::ordered_json results;
   results["model"] = where;
   results["name"] = name;
   results["data"] = data.info().root.string();
   results["spec"] = spec_summary(input.network->spec());
   results["pruned_spec"] = spec_summary(pruned.network->spec());
-  auto units_json = nlohmann::ordered_json::array();
-  for (size_t u = 0; u < units.size(); ++u) {
-    nlohmann::ordered_json j;
-    j["unit"] = units[u].name;
-    j["groups"] = units[u].groups;
-    j["widths"] = units[u].widths;
-    j["pool_patterns"] = build.pool.units[u].patterns.size();
-    j["selected_per_pattern"] = counts[u];
-    units_json.push_back(j);
-  }
-  results["units"] = units_json;
+  results["pool"] = to_json(pool);
+  results["keep_rates"] = options.pool.keep_rates;
+  results["selected_per_pattern"] = counts;
+  results["latency_table"] = {{"lr_size", {hybrid.latency.lr_width, hybrid.latency.lr_height}},
+                              {"median_ms", hybrid.latency.median_ms}};
   results["importance"] = options.importance;
   results["pool_frames"] = pool_frames.size();
-  results["warmup_accuracy"] = warmup_accuracy;
+  results["selector"] = to_json(fit);
+  results["mean_macs_train"] = mean_macs;
   results["left_out"] = pruned.left_out;
   results["finetune"] = {{"steps", schedule.steps}, {"hybrid", to_json(hybrid_training)}};
   results["files"] = {{"hybrid", hybrid_path.string()}, {"pool", (out / "pool.json").string()}};
 
-  // 5. The magnitude pruning baseline, same per-frame rate and budget.
+  // 5. The magnitude pruning baseline at the hybrid model's mean MACs, same steps.
   Model original = load_model(model_path);
   std::optional<SRNetwork> mmp;
   if (options.magnitude_baseline) {
-    Inheritance baseline = magnitude_prune(*original.network, options.pool.keep_rate);
-    spdlog::info("fine-tuning the magnitude pruning baseline ({}): {} steps", spec_summary(baseline.network->spec()),
-                 schedule.steps);
+    const double rate = magnitude_rate_for_macs(*original.network, static_cast<int64_t>(mean_macs), lr.width, lr.height);
+    Inheritance baseline = magnitude_prune(*original.network, rate);
+    spdlog::info("fine-tuning the magnitude pruning baseline ({}, keep rate {:.3f}): {} steps",
+                 spec_summary(baseline.network->spec()), rate, schedule.steps);
     Trainer trainer(baseline.network, data, schedule, options.finetune.loss);
     const TrainOutcome outcome = trainer.run(out / "finetune_mmp.pt", resume);
     Provenance p;
@@ -134,13 +170,13 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
     p.parent = where;
     p.config = config;
     p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
-    p.extra = {{"name", name + " MMP"}, {"data", data.info().root.string()}};
+    p.extra = {{"name", name + " MMP"}, {"data", data.info().root.string()}, {"keep_rate", rate}};
     save_model(out / "mmp.cgsr", *baseline.network, p);
     results["finetune"]["mmp"] = to_json(outcome);
     results["files"]["mmp"] = (out / "mmp.cgsr").string();
+    results["mmp_keep_rate"] = rate;
     mmp = baseline.network;
   }
-
   // 6. Held-out evaluation through the same code path as `cgsr eval`.
   std::vector<EvalResult> evaluations;
   {
@@ -158,6 +194,9 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   {
     HybridUpscaler from_file(name + " hybrid", load_hybrid_model(hybrid_path));
     evaluations.push_back(evaluate(from_file, data, options.eval));
+    std::vector<int64_t> usage(hybrid.pool.size(), 0);
+    for (const auto& f : evaluations.back().frames) ++usage.at(f.details.at("pattern").get<int>());
+    results["test_selected_per_pattern"] = usage;
   }
   results["evaluations"] = nlohmann::ordered_json::array();
   results["comparison"] = nlohmann::ordered_json::array();

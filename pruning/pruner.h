@@ -1,12 +1,15 @@
 #pragma once
 // Hybrid pruning of a trained network for one scene (the paper's second phase), end to end:
 //
-//   1. units (prunable_units.h) and, per training frame, channel importance (Taylor by default)
-//   2. the pattern pool by frequency-based sorting (pattern_pool.h)
-//   3. dynamic samplers warmed up on each frame's pool entry, then fine-tuning of network and
-//      samplers with L_p (dynamic_pruning.h), `finetune.epochs` epochs (paper: 2)
-//   4. static pruning of what no training frame selects (static_pruning.h)
-//   5. the magnitude pruning baseline at the per-frame rate, fine-tuned with the same budget
+//   1. per training frame, channel importance (Taylor by default); the network's channels are
+//      reordered by it, and the pool of nested patterns built (pattern_pool.h)
+//   2. fine-tuning of every pattern by the sandwich rule with L_p (dynamic_pruning.h)
+//   3. the dynamic pruning component fitted to choose, per frame, the cheapest pattern that
+//      does not cost the frame quality, within the budget (dynamic_pruning.h)
+//   4. static pruning of the patterns no training frame selects (static_pruning.h), and the
+//      latency table of the remaining ones
+//   5. the magnitude pruning baseline at the hybrid model's mean MACs on the training frames,
+//      fine-tuned with the same number of steps
 //   6. evaluation of the input model, the baseline, the static network alone and the hybrid
 //      model on held-out frames, through the same evaluate() as `cgsr eval`
 // Writes <out>/pruned.cgsr (hybrid; plain load_model() reads its static network), mmp.cgsr,
@@ -32,12 +35,11 @@ namespace cgsr {
 struct PruneOptions {
   std::string name;                 // display name of the input model (default: recorded name or file stem)
   std::string importance = "taylor";  // taylor | activation
-  int pool_frames = 0;              // training frames ranked for the pool and the warm-up (0 = all)
+  int pool_frames = 0;              // training frames whose importance orders the channels (0 = all)
   PoolOptions pool;
   SamplerOptions sampler;
-  int warmup_steps = 300;           // sampler warm-up steps (full batch of the pool frames)
-  double warmup_lr = 1e-2;
   FinetuneOptions finetune;
+  SelectorOptions selector;
   StaticPruneOptions static_prune;
   bool magnitude_baseline = true;
   EvalOptions eval;                 // held-out evaluation of every model
@@ -54,17 +56,17 @@ void add_prune_fields(config::Schema<T>& s) {
   s.field("name", m(&PruneOptions::name), "display name of the input model in reports (default: the recorded one)");
   s.field("importance", m(&PruneOptions::importance), "per-frame channel importance for the pattern pool")
       .one_of({"taylor", "activation"});
-  s.field("pool_frames", m(&PruneOptions::pool_frames), "training frames ranked for the pattern pool (0 = all)")
+  s.field("pool_frames", m(&PruneOptions::pool_frames),
+          "training frames whose channel importance orders the channels (0 = all)")
       .at_least(0);
-  s.section("pool", m(&PruneOptions::pool), pool_schema(), "pattern pool (frequency-based sorting)");
-  s.section("sampler", m(&PruneOptions::sampler), sampler_schema(), "dynamic samplers of the pruning components");
-  s.field("warmup_steps", m(&PruneOptions::warmup_steps), "sampler warm-up steps before fine-tuning")
-      .range(0, 100000);
-  s.field("warmup_lr", m(&PruneOptions::warmup_lr), "sampler warm-up learning rate").range(1e-9, 10);
-  s.section("finetune", m(&PruneOptions::finetune), finetune_schema(), "fine-tuning with L_p (Eq. 4)");
+  s.section("pool", m(&PruneOptions::pool), pool_schema(), "pattern pool (nested channel widths)");
+  s.section("sampler", m(&PruneOptions::sampler), sampler_schema(), "the dynamic pruning component's sampler");
+  s.section("finetune", m(&PruneOptions::finetune), finetune_schema(),
+            "fine-tuning of every pattern with L_p (Eq. 4, sandwich rule)");
+  s.section("selector", m(&PruneOptions::selector), selector_schema(), "fitting the per-frame pattern choice");
   s.section("static", m(&PruneOptions::static_prune), static_prune_schema(), "static pruning");
   s.field("magnitude_baseline", m(&PruneOptions::magnitude_baseline),
-          "also prune by L1 magnitude at the same per-frame rate, fine-tuned with the same budget (MMP)");
+          "also prune by L1 magnitude to the hybrid model's mean MACs, fine-tuned with the same steps (MMP)");
   s.section("eval", m(&PruneOptions::eval), eval_schema_fields(), "held-out evaluation of every model");
 }
 

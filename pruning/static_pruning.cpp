@@ -37,50 +37,24 @@ std::vector<std::pair<std::string, double>> rit_channel_contributions(const SRNe
   return out;
 }
 
-StaticPruning static_prune(const SRNetworkImpl& net, const PatternPool& pool,
-                           const std::vector<std::vector<int64_t>>& counts, const StaticPruneOptions& options) {
-  CGSR_CHECK(counts.size() == pool.units.size(), "static_prune: one count list per unit");
+StaticPruning static_prune(const SRNetworkImpl& net, const PatternPool& pool, const std::vector<int64_t>& counts,
+                           const StaticPruneOptions& options) {
+  CGSR_CHECK(counts.size() == static_cast<size_t>(pool.size()), "static_prune: one count per pattern");
   StaticPruning result;
   result.left_out = nlohmann::ordered_json::object();
-  auto groups_json = nlohmann::ordered_json::object();
-  auto patterns_json = nlohmann::ordered_json::object();
-
-  PatternPool selected;
-  for (size_t u = 0; u < pool.units.size(); ++u) {
-    const auto& up = pool.units[u];
-    CGSR_CHECK(counts[u].size() == up.patterns.size(), "static_prune: counts of unit " + up.unit.name);
-    std::vector<int> kept;
-    for (size_t k = 0; k < up.patterns.size(); ++k)
-      if (counts[u][k] > 0) kept.push_back(static_cast<int>(k));
-    if (kept.empty()) throw Error("static pruning", "no frame selected any pattern of unit " + up.unit.name);
-    UnitPatterns s;
-    s.unit = up.unit;
-    for (int k : kept) {
-      Pattern p = up.patterns[k];
-      p.frames = static_cast<int>(counts[u][k]);
-      s.patterns.push_back(std::move(p));
-    }
-    patterns_json[up.unit.name] = {{"pool", up.patterns.size()}, {"kept", kept.size()}};
-    result.kept.push_back(kept);
-    selected.units.push_back(std::move(s));
-  }
-  result.channels = selected.union_selection();
+  for (int k = 0; k < pool.size(); ++k)
+    if (counts[k] > 0) result.kept.push_back(k);
+  if (result.kept.empty()) throw Error("static pruning", "no frame selected any pattern");
+  result.channels = pool.selection(result.kept.front());
 
   ArchSpec child = net.spec();
   child.geometry.enabled = false;
-  for (const auto& u : selected.units)
-    for (size_t i = 0; i < u.unit.groups.size(); ++i) {
-      const auto& g = u.unit.groups[i];
-      const auto& kept = result.channels.at(g);
-      child.set_group_width(g, static_cast<int>(kept.size()));
-      std::vector<int64_t> removed;
-      for (int64_t c = 0, k = 0; c < u.unit.widths[i]; ++c) {
-        if (k < static_cast<int64_t>(kept.size()) && kept[k] == c)
-          ++k;
-        else
-          removed.push_back(c);
-      }
-      groups_json[g] = {{"width", u.unit.widths[i]}, {"kept", kept.size()}, {"removed", removed}};
+  auto groups_json = nlohmann::ordered_json::object();
+  for (const auto& u : pool.units)
+    for (size_t i = 0; i < u.groups.size(); ++i) {
+      const int64_t kept = static_cast<int64_t>(result.channels.at(u.groups[i]).size());
+      child.set_group_width(u.groups[i], static_cast<int>(kept));
+      if (kept < u.widths[i]) groups_json[u.groups[i]] = {{"width", u.widths[i]}, {"kept", kept}};
     }
 
   auto rit_json = nlohmann::ordered_json::array();
@@ -113,27 +87,10 @@ StaticPruning static_prune(const SRNetworkImpl& net, const PatternPool& pool,
   result.network = inherit(net, resolve_spec(child), result.channels).network;
   result.network->eval();
 
-  // The pool in the smaller network's channel indices.
-  for (auto& u : selected.units) {
-    for (auto& p : u.patterns)
-      for (auto& [g, channels] : p.keep) {
-        const auto& kept = result.channels.at(g);
-        for (auto& c : channels) c = std::lower_bound(kept.begin(), kept.end(), c) - kept.begin();
-      }
-    for (size_t i = 0; i < u.unit.groups.size(); ++i)
-      u.unit.widths[i] = static_cast<int64_t>(result.channels.at(u.unit.groups[i]).size());
-  }
-  const auto units = find_units(result.network->describe(false));
-  CGSR_CHECK(units.size() == selected.units.size(), "static_prune: the pruned network has different units");
-  for (size_t u = 0; u < units.size(); ++u) {
-    CGSR_CHECK(units[u].groups == selected.units[u].unit.groups && units[u].widths == selected.units[u].unit.widths,
-               "static_prune: unit " + units[u].name + " changed shape");
-    selected.units[u].unit = units[u];
-  }
-  result.pool = std::move(selected);
+  result.pool = keep_patterns(pool, result.kept, find_units(result.network->describe(false)));
 
   result.left_out["channels"] = groups_json;
-  result.left_out["patterns"] = patterns_json;
+  result.left_out["patterns"] = {{"pool", pool.size()}, {"kept", result.kept}};
   result.left_out["rit_channels"] = rit_json;
   result.left_out["geometry_head"] = net.has_geometry_head();
   return result;

@@ -138,6 +138,15 @@ std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::option
 }
 }  // namespace
 
+std::vector<Batch> timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
+                                   const Upscaler& upscaler, int count) {
+  constexpr size_t kMaxFrames = 8;  // frames held in memory (a 1080p batch is tens of MB)
+  std::vector<Batch> out;
+  for (size_t i = 0; i < frames.size() && out.size() < std::min<size_t>(kMaxFrames, std::max(1, count)); ++i)
+    out.push_back(frame_batch(data, frames[i], scale, upscaler.channels(), upscaler.depth_encoding()));
+  return out;
+}
+
 EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options,
                     const std::function<void(const EvalResult&)>& on_quality) {
   EvalResult result;
@@ -242,11 +251,15 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   result.cost = upscaler.cost(result.lr_width, result.lr_height);
   if (on_quality) on_quality(result);
   if (options.latency_runs > 0) {
+    // Timed on the evaluated frames in turn, as a renderer calls it: an upscaler whose work
+    // depends on the frame (a hybrid-pruned model) is timed on what it chooses per frame.
+    const std::vector<Batch> sequence = timing_sequence(data, frames, result.scale, upscaler, options.latency_runs);
     constexpr int kWarmup = 2;
     Progress timing("latency " + result.name, kWarmup + options.latency_runs);
+    size_t next = 0;
     result.latency = measure_latency(
         [&] {
-          upscaler.upscale(first);
+          upscaler.upscale(sequence[next++ % sequence.size()]);
           timing.advance();
         },
         kWarmup, options.latency_runs);
@@ -308,17 +321,12 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
   j["temporal_error"] = r.temporal_error ? nlohmann::ordered_json(*r.temporal_error) : nullptr;
   j["temporal_error_reference"] =
       r.temporal_error_reference ? nlohmann::ordered_json(*r.temporal_error_reference) : nullptr;
-  if (r.latency) {
-    j["latency_ms"] = {{"median", r.latency->median_ms}, {"min", r.latency->min_ms}, {"max", r.latency->max_ms},
-                       {"runs", r.latency->runs}};
-  } else {
-    j["latency_ms"] = nullptr;
-  }
-  if (r.onnxruntime_latency)
-    j["onnxruntime_latency_ms"] = {{"median", r.onnxruntime_latency->median_ms},
-                                   {"min", r.onnxruntime_latency->min_ms},
-                                   {"max", r.onnxruntime_latency->max_ms},
-                                   {"runs", r.onnxruntime_latency->runs}};
+  const auto latency_json = [](const LatencyStats& l) {
+    return nlohmann::ordered_json{{"median", l.median_ms}, {"mean", l.mean_ms}, {"p95", l.p95_ms},
+                                  {"min", l.min_ms},       {"max", l.max_ms},   {"runs", l.runs}};
+  };
+  j["latency_ms"] = r.latency ? latency_json(*r.latency) : nullptr;
+  if (r.onnxruntime_latency) j["onnxruntime_latency_ms"] = latency_json(*r.onnxruntime_latency);
   if (r.cost) {
     j["params"] = r.cost->params;
     j["macs"] = r.cost->macs;
@@ -365,6 +373,8 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
       stats.median_ms = l.at("median");
       stats.min_ms = l.at("min");
       stats.max_ms = l.at("max");
+      stats.mean_ms = l.value("mean", stats.median_ms);
+      stats.p95_ms = l.value("p95", stats.max_ms);
       stats.runs = l.at("runs");
       return stats;
     };

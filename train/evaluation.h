@@ -27,7 +27,7 @@ struct EvalOptions {
   int crop_border = 0;         // pixels (HR) ignored at each side
   bool y_channel = false;      // PSNR/SSIM on BT.601 luma instead of RGB
   bool temporal = true;        // needs motion vectors and the previous frame
-  int latency_runs = 10;       // timed runs (after 2 warm-up runs) on one frame; 0 = skip
+  int latency_runs = 10;       // timed runs (after 2 warm-up runs) over the first frames in turn; 0 = skip
   std::string save_frames;     // directory for SR frames as PNG; "" = do not save
 };
 config::Schema<EvalOptions> eval_schema_fields();
@@ -65,6 +65,11 @@ struct EvalResult {
   std::optional<LatencyStats> onnxruntime_latency;
   std::optional<Complexity> cost;
 };
+
+// The first frames of `frames` (at most `count`, at most 8) as the upscaler reads them: the
+// sequence latency is timed on, in turn.
+std::vector<Batch> timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
+                                   const Upscaler& upscaler, int count);
 
 // `on_quality` is called once the quality figures are known, before the latency is measured
 // (which can take minutes at 1080p), so callers can write them out early.

@@ -377,7 +377,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
 
   // report: one table and plot of every model. The stages timed their models minutes or hours
   // apart, under whatever else the machine was doing then; the report times them again side by
-  // side, in interleaved rounds on one test frame, so that their latencies compare.
+  // side, in interleaved rounds over the test frames in turn, so that their latencies compare.
   const std::string searched_name = pruned.summary.at("name").get<std::string>();
   const std::map<std::string, fs::path> model_files = {
       {trained.summary.at("name").get<std::string>(), backbone_file},
@@ -400,9 +400,11 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
         std::vector<EvalResult> evaluations = collect_evaluations(runs);
         if (eval.latency_runs > 0) {
           std::vector<std::unique_ptr<Upscaler>> upscalers;
-          std::vector<Batch> frames;
+          std::vector<std::vector<Batch>> sequences;  // per model, test frames timed in turn
+          std::vector<Batch> frames;                   // per model, the first of them
           std::vector<std::function<void()>> timed;
-          const int frame = data.frames(Split::Test).empty() ? 0 : data.frames(Split::Test).front();
+          const std::vector<int> test_frames =
+              data.frames(Split::Test).empty() ? std::vector<int>{0} : data.frames(Split::Test);
           for (const auto& e : evaluations) {
             const auto file = model_files.find(e.name);
             if (e.name == searched_name + " static")  // the static network inside the hybrid model file
@@ -410,12 +412,16 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
             else
               upscalers.push_back(make_upscaler(file == model_files.end() ? e.name : file->second.string(), e.name,
                                                 backbone.scale));
-            frames.push_back(frame_batch(data, frame, backbone.scale, upscalers.back()->channels(),
-                                               upscalers.back()->depth_encoding()));
+            sequences.push_back(
+                timing_sequence(data, test_frames, backbone.scale, *upscalers.back(), eval.latency_runs));
+            frames.push_back(sequences.back().front());
           }
           for (size_t i = 0; i < upscalers.size(); ++i)
-            timed.push_back([&, i] { upscalers[i]->upscale(frames[i]); });
-          spdlog::info("timing {} models side by side ({} interleaved rounds)", timed.size(), eval.latency_runs);
+            timed.push_back([&, i, next = size_t{0}]() mutable {
+              upscalers[i]->upscale(sequences[i][next++ % sequences[i].size()]);
+            });
+          spdlog::info("timing {} models side by side ({} interleaved rounds over {} test frames)", timed.size(),
+                       eval.latency_runs, sequences.front().size());
           const auto latency = measure_latency_interleaved(timed, /*warmup=*/2, eval.latency_runs);
           for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
           time_in_onnxruntime(evaluations, onnx_files, frames, eval.latency_runs);
@@ -433,6 +439,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
   roles.cg_optimized = find_result(evaluations, searched_name);
   roles.pruned = find_result(evaluations, searched_name + " hybrid");
+  roles.pruned_static = find_result(evaluations, searched_name + " static");
+  roles.magnitude = find_result(evaluations, searched_name + " MMP");
   if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
     throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + searched_name + ")",
                 ErrorKind::Internal);

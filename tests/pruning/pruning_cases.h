@@ -1,6 +1,6 @@
 #pragma once
 // Shared fixtures of the pruning tests: small networks of every backbone (with and without a
-// RIT, pixel-shuffle and attention groups included), random weights, random pattern pools, and
+// RIT, pixel-shuffle and attention groups included), random weights, random channel orders, and
 // the masked dense reference computation a pattern's execution must equal.
 
 #include <torch/torch.h>
@@ -64,29 +64,18 @@ inline std::pair<torch::Tensor, torch::Tensor> inputs_for(const SRNetworkImpl& n
   return {color, info};
 }
 
-// `k` random patterns per unit keeping kept_count(width, rate) channels of every group.
-inline PatternPool random_pool(const std::vector<PrunableUnit>& units, int k, double rate, uint32_t seed) {
+// A random permutation of every unit group's channels (what order_channels takes).
+inline ChannelSelection random_order(const std::vector<PrunableUnit>& units, uint32_t seed) {
   std::mt19937 rng(seed);
-  PatternPool pool;
-  for (const auto& u : units) {
-    UnitPatterns up;
-    up.unit = u;
-    for (int i = 0; i < k; ++i) {
-      Pattern p;
-      p.frames = k - i;
-      for (size_t g = 0; g < u.groups.size(); ++g) {
-        std::vector<int64_t> all(u.widths[g]);
-        for (int64_t c = 0; c < u.widths[g]; ++c) all[c] = c;
-        std::shuffle(all.begin(), all.end(), rng);
-        all.resize(kept_count(u.widths[g], rate));
-        std::sort(all.begin(), all.end());
-        p.keep[u.groups[g]] = all;
-      }
-      up.patterns.push_back(p);
+  ChannelSelection order;
+  for (const auto& u : units)
+    for (size_t g = 0; g < u.groups.size(); ++g) {
+      std::vector<int64_t> all(u.widths[g]);
+      for (int64_t c = 0; c < u.widths[g]; ++c) all[c] = c;
+      std::shuffle(all.begin(), all.end(), rng);
+      order[u.groups[g]] = all;
     }
-    pool.units.push_back(up);
-  }
-  return pool;
+  return order;
 }
 
 // The reference: the dense network with every convolution's input columns of removed channels

@@ -1,11 +1,12 @@
-// Hybrid model files: the static network loads as a plain model, the dynamic pruning components
-// round-trip exactly, and the upscaler chooses per frame from current and previous information.
+// Hybrid model files: the static network loads as a plain model, the dynamic pruning component
+// and the latency table round-trip exactly, and the upscaler chooses per frame from current and
+// previous rendering information, running the chosen pattern.
 #include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "pruning/hybrid_model.h"
 #include "pruning/hybrid_upscaler.h"
-#include "pruning/pattern_executor.h"
+#include "pruning/pattern_networks.h"
 #include "pruning/static_pruning.h"
 #include "tests/pruning/pruning_cases.h"
 #include "tests/support/cli_runner.h"
@@ -18,22 +19,20 @@ HybridModel make_hybrid() {
   SRNetwork net(small_spec("pan", 2, 2, 6, 8, /*rit=*/true));
   randomize(*net);
   net->eval();
-  const auto units = find_units(net->describe(false));
-  const PatternPool pool = random_pool(units, 3, 0.5, 7);
-  std::vector<std::vector<int64_t>> counts;
-  for (const auto& u : pool.units) counts.push_back({3, 0, 1});
+  const PatternPool pool = nested_pool(find_units(net->describe(false)), {1.0, 0.7, 0.5, 0.3});
   StaticPruneOptions options;
   options.rit_threshold = 0;
-  StaticPruning pruned = static_prune(*net, pool, counts, options);
+  StaticPruning pruned = static_prune(*net, pool, {0, 3, 1, 2}, options);
   SamplerOptions so;
   so.channels = {"depth", "edge"};
   so.grid = 4;
   so.width = 3;
   HybridModel h;
-  h.samplers = DynamicSamplers(so, std::vector<int>(units.size(), 3));
-  h.samplers->keep_patterns(pruned.kept);
+  h.samplers = DynamicSamplers(so, std::vector<int>{pool.size()});
+  h.samplers->keep_patterns({pruned.kept});
   h.network = pruned.network;
   h.pool = pruned.pool;
+  h.latency = {6, 5, {3.0, 2.0, 1.5}};
   h.provenance.stage = "pruned";
   h.provenance.extra = {{"name", "tiny hybrid"}};
   return h;
@@ -64,21 +63,21 @@ TEST(HybridModel, RoundTripsAndLoadsAsAPlainModel) {
 
   HybridModel loaded = load_hybrid_model(path);
   EXPECT_EQ(to_json(loaded.pool), to_json(h.pool));
+  EXPECT_EQ(loaded.latency.median_ms, h.latency.median_ms);
+  EXPECT_EQ(loaded.latency.lr_width, 6);
   HybridUpscaler a("a", h), b("b", loaded);
   EXPECT_EQ(b.channels(), parse_channels({"depth", "normal_angle", "edge"}));
   for (int i = 0; i < 3; ++i) {
     const Batch f = frame(i);
     EXPECT_TRUE(torch::equal(a.upscale(f), b.upscale(f)));
-    EXPECT_EQ(a.frame_details()["patterns"], b.frame_details()["patterns"]);
+    EXPECT_EQ(a.frame_details()["pattern"], b.frame_details()["pattern"]);
   }
-  // The output is the chosen patterns' execution on the static network.
+  // The output is the chosen pattern run on the static network.
   const Batch f = frame(7);
   const auto out = b.upscale(f);
-  std::vector<int> choice;
-  const auto details = b.frame_details();  // a copy: iterating a temporary's items() would dangle
-  for (const auto& [unit, k] : details["patterns"].items()) choice.push_back(k.get<int>());
-  PatternExecutor exec(*loaded.network, loaded.pool);
-  EXPECT_TRUE(torch::allclose(out, exec.run(f.lr_color, f.lr_info, choice), 0, 1e-6));
+  const int k = b.frame_details()["pattern"].get<int>();
+  PatternNetworks patterns(*loaded.network, loaded.pool);
+  EXPECT_TRUE(torch::allclose(out, patterns.run(k, f.lr_color, f.lr_info), 0, 1e-6));
   EXPECT_GE(b.frame_details()["choose_ms"].get<double>(), 0.0);
 
   save_model(dir / "plain.cgsr", *h.network);
@@ -106,4 +105,42 @@ TEST(HybridModel, UsesThePreviousFrame) {
   const auto cost = up.cost(6, 5);
   ASSERT_TRUE(cost.has_value());
   EXPECT_GT(cost->macs, 0);
+}
+
+// The component reads the rendering information: a sampler taught that edge-dense frames need
+// the widest pattern and flat ones the narrowest chooses so in the upscaler.
+TEST(HybridModel, TheChoiceFollowsTheRenderingInformation) {
+  torch::manual_seed(19);
+  HybridModel h = make_hybrid();
+  const int narrowest = h.pool.size() - 1;
+  const auto channels = h.samplers->options().render_channels();
+  const auto input_for = [&](float edge) {
+    auto info = torch::full({1, 2, 5, 6}, 0.5f);
+    info[0][1].fill_(edge);
+    return sampler_input(info, {}, channels, h.samplers->options().grid);
+  };
+  const auto inputs = torch::cat({input_for(1.0f), input_for(0.0f)}, 0);
+  const auto target = torch::tensor({int64_t{0}, int64_t{narrowest}});
+  torch::optim::Adam optimizer(h.samplers->parameters(), torch::optim::AdamOptions(0.05));
+  for (int step = 0; step < 200; ++step) {
+    const auto loss = torch::nn::functional::cross_entropy(h.samplers->forward(inputs).select(1, 0), target);
+    optimizer.zero_grad();
+    loss.backward();
+    optimizer.step();
+  }
+  HybridUpscaler up("h", h);
+  Batch edges = frame(1), flat = frame(3);
+  edges.lr_info = torch::full({1, 3, 5, 6}, 0.5f);
+  edges.lr_info[0][2].fill_(1.0f);
+  flat.lr_info = torch::full({1, 3, 5, 6}, 0.5f);
+  flat.lr_info[0][2].fill_(0.0f);
+  EXPECT_EQ(up.choose(edges), 0);
+  EXPECT_EQ(up.choose(flat), narrowest);
+  // Mean MACs follow the choices: one frame each of the widest and the narrowest pattern.
+  up.upscale(edges);
+  up.upscale(flat);
+  PatternNetworks patterns(*h.network, h.pool);
+  const int64_t expected = (patterns.cost(0, 6, 5).macs + patterns.cost(narrowest, 6, 5).macs) / 2;
+  EXPECT_NEAR(static_cast<double>(up.cost(6, 5)->macs - h.samplers->macs()), static_cast<double>(expected), 1.0);
+  EXPECT_EQ(up.usage(), (std::vector<int64_t>{1, 0, 1}));
 }

@@ -1,111 +1,106 @@
-// Frequency-based sorting on controlled per-frame importance: the pool holds the most frequent
-// patterns, merges near-identical ones by the documented rule, and assigns frames to the nearest.
+// The pool of nested patterns: widths from keep rates, channels ordered by importance (the
+// reordered network computes the same), and the pool's file form with its checks.
 #include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "pruning/pattern_pool.h"
+#include "tests/pruning/pruning_cases.h"
 
 using namespace cgsr;
+using namespace cgsr::test;
 
 namespace {
 PrunableUnit two_groups() {
   PrunableUnit u;
   u.name = "block0";
   u.groups = {"block0_a", "block0_b"};
-  u.widths = {4, 4};
+  u.widths = {4, 10};
   return u;
 }
-
-// Importance favouring channels `a` of block0_a and `b` of block0_b.
-FrameImportance favour(std::vector<int> a, std::vector<int> b) {
-  auto ia = torch::full({4}, 0.1f), ib = torch::full({4}, 0.1f);
-  for (size_t i = 0; i < a.size(); ++i) ia[a[i]] = 2.0f - 0.1f * i;
-  for (size_t i = 0; i < b.size(); ++i) ib[b[i]] = 2.0f - 0.1f * i;
-  return {{"block0_a", ia}, {"block0_b", ib}};
-}
-
-std::vector<FrameImportance> controlled_frames() {
-  std::vector<FrameImportance> f;
-  for (int i = 0; i < 5; ++i) f.push_back(favour({0, 1}, {0, 1}));
-  for (int i = 0; i < 3; ++i) f.push_back(favour({2, 3}, {2, 3}));
-  f.push_back(favour({0, 1}, {0, 2}));  // frame 8: one channel off the first pattern
-  f.push_back(favour({2, 3}, {1, 3}));  // frame 9: one channel off the second
-  return f;
-}
-
-using Keep = std::vector<int64_t>;
 }  // namespace
 
-TEST(PatternPool, TopChannelsPerGroup) {
-  const auto keep = top_channels(two_groups(), favour({3, 1}, {2, 0}), 0.5);
-  EXPECT_EQ(keep.at("block0_a"), (Keep{1, 3}));
-  EXPECT_EQ(keep.at("block0_b"), (Keep{0, 2}));
+TEST(PatternPool, NestedWidthsFromKeepRates) {
+  const PatternPool pool = nested_pool({two_groups()}, {1.0, 0.5, 0.2});
+  ASSERT_EQ(pool.size(), 3);
+  EXPECT_EQ(pool.widths[0].at("block0_a"), 4);
+  EXPECT_EQ(pool.widths[1].at("block0_a"), 2);
+  EXPECT_EQ(pool.widths[2].at("block0_a"), 1);
+  EXPECT_EQ(pool.widths[1].at("block0_b"), 5);
+  EXPECT_EQ(pool.widths[2].at("block0_b"), 2);
+  EXPECT_EQ(pool.selection(1).at("block0_b"), (std::vector<int64_t>{0, 1, 2, 3, 4}));
+  EXPECT_DOUBLE_EQ(pool.channel_fraction(0), 1.0);
+  EXPECT_DOUBLE_EQ(pool.channel_fraction(1), 7.0 / 14.0);
+  EXPECT_DOUBLE_EQ(pool.channel_fraction(2), 3.0 / 14.0);
+  EXPECT_THROW(pool.selection(3), Error);
+  EXPECT_THROW(nested_pool({two_groups()}, {0.5, 0.5}), Error);  // not decreasing
+  EXPECT_THROW(nested_pool({two_groups()}, {1.0, 0.0}), Error);
+  EXPECT_THROW(nested_pool({two_groups()}, {0.2, 0.19}), Error);  // the same channels twice
 }
 
-TEST(PatternPool, MostFrequentExactPatterns) {
-  PoolOptions o;
-  o.keep_rate = 0.5;
-  o.size = 2;
-  o.merge_tolerance = 0;
-  const auto build = build_pattern_pool({two_groups()}, controlled_frames(), o);
-  const auto& p = build.pool.units.at(0).patterns;
-  ASSERT_EQ(p.size(), 2u);
-  EXPECT_EQ(p[0].keep.at("block0_a"), (Keep{0, 1}));
-  EXPECT_EQ(p[0].keep.at("block0_b"), (Keep{0, 1}));
-  EXPECT_EQ(p[1].keep.at("block0_a"), (Keep{2, 3}));
-  EXPECT_EQ(p[1].keep.at("block0_b"), (Keep{2, 3}));
-  // Frames 8 and 9 join their nearest entries.
-  EXPECT_EQ(p[0].frames, 6);
-  EXPECT_EQ(p[1].frames, 4);
-  EXPECT_EQ(build.assignment[8][0], 0);
-  EXPECT_EQ(build.assignment[9][0], 1);
-  EXPECT_EQ(build.assignment[6][0], 1);
+TEST(PatternPool, OrdersChannelsByNormalizedImportance) {
+  PrunableUnit u;
+  u.name = "block0";
+  u.groups = {"block0_a"};
+  u.widths = {3};
+  // Frame 0 has ten times the scale of frame 1; normalized, channel 2 wins on average.
+  const std::vector<FrameImportance> frames = {{{"block0_a", torch::tensor({10.0f, 9.0f, 8.0f})}},
+                                               {{"block0_a", torch::tensor({0.0f, 0.2f, 0.8f})}}};
+  EXPECT_EQ(importance_order({u}, frames).at("block0_a"), (std::vector<int64_t>{2, 1, 0}));
+  EXPECT_THROW(importance_order({u}, {}), Error);
+  EXPECT_THROW(importance_order({u}, {{{"other", torch::ones({3})}}}), Error);
 }
 
-TEST(PatternPool, RarePatternsFillALargerPool) {
-  PoolOptions o;
-  o.keep_rate = 0.5;
-  o.size = 3;
-  o.merge_tolerance = 0;
-  const auto build = build_pattern_pool({two_groups()}, controlled_frames(), o);
-  const auto& p = build.pool.units.at(0).patterns;
-  ASSERT_EQ(p.size(), 3u);
-  // The third entry is frame 8's pattern (tie with frame 9 broken by the earlier frame).
-  EXPECT_EQ(p[2].keep.at("block0_b"), (Keep{0, 2}));
-  EXPECT_EQ(p[0].frames, 5);
-  EXPECT_EQ(p[1].frames, 4);
-  EXPECT_EQ(p[2].frames, 1);
+TEST(PatternPool, ReorderedNetworkComputesTheSame) {
+  torch::manual_seed(3);
+  for (const auto& c : net_cases()) {
+    SCOPED_TRACE(c.name);
+    SRNetwork net(c.spec);
+    randomize(*net);
+    net->eval();
+    const auto units = find_units(net->describe(false));
+    const auto order = random_order(units, 5);
+    SRNetwork ordered = order_channels(*net, order).network;
+    ordered->eval();
+    const auto [color, info] = inputs_for(*net, 7, 5);
+    torch::NoGradGuard no_grad;
+    EXPECT_LT(max_diff(ordered->forward(color, info), net->forward(color, info)), 1e-4);
+    // The channels really moved: the first unit group's producing weights are permuted.
+    const auto& g = units.front().groups.front();
+    const auto before = net->channel_importance().at(g), after = ordered->channel_importance().at(g);
+    EXPECT_TRUE(torch::allclose(after, before.index_select(0, torch::tensor(order.at(g), torch::kLong))));
+  }
 }
 
-TEST(PatternPool, NearIdenticalPatternsMergeIntoTheirConsensus) {
-  std::vector<FrameImportance> f = {favour({0, 1}, {0, 1}), favour({0, 1}, {0, 1}), favour({0, 1}, {0, 2}),
-                                    favour({0, 1}, {0, 3}), favour({2, 3}, {2, 3})};
-  PoolOptions o;
-  o.keep_rate = 0.5;
-  o.size = 4;
-  o.merge_tolerance = 0.25;  // one of the 4 kept channels may differ
-  const auto build = build_pattern_pool({two_groups()}, f, o);
-  const auto& p = build.pool.units.at(0).patterns;
-  ASSERT_EQ(p.size(), 2u);  // frames 0-3 form one cluster
-  EXPECT_EQ(p[0].frames, 4);
-  EXPECT_EQ(p[0].keep.at("block0_b"), (Keep{0, 1}));  // 0 chosen 4 times, 1 twice
-  EXPECT_EQ(p[1].frames, 1);
+TEST(PatternPool, JsonRoundTripAndChecks) {
+  const PatternPool pool = nested_pool({two_groups()}, {1.0, 0.5});
+  const auto j = to_json(pool);
+  const PatternPool back = pool_from_json(j, {two_groups()}, "pool.json");
+  EXPECT_EQ(back.widths, pool.widths);
+  auto wider = j;
+  wider["patterns"][1]["block0_a"] = 4;
+  wider["patterns"][0]["block0_a"] = 3;
+  EXPECT_THROW(pool_from_json(wider, {two_groups()}, "pool.json"), Error);  // not nested
+  auto zero = j;
+  zero["patterns"][1]["block0_b"] = 0;
+  EXPECT_THROW(pool_from_json(zero, {two_groups()}, "pool.json"), Error);
+  PrunableUnit other = two_groups();
+  other.widths = {4, 8};
+  try {
+    pool_from_json(j, {other}, "pool.json");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("pool.json"), std::string::npos);
+  }
 }
 
-TEST(PatternPool, UnionAndJsonRoundTrip) {
-  PoolOptions o;
-  o.keep_rate = 0.5;
-  o.size = 2;
-  const auto build = build_pattern_pool({two_groups()}, controlled_frames(), o);
-  const auto all = build.pool.union_selection();
-  EXPECT_EQ(all.at("block0_a"), (Keep{0, 1, 2, 3}));
-  EXPECT_EQ(build.pool.selection({1}).at("block0_b"), (Keep{2, 3}));
-  const auto back = pool_from_json(to_json(build.pool), {two_groups()}, "test");
-  EXPECT_EQ(to_json(back), to_json(build.pool));
-  auto other = two_groups();
-  other.widths = {4, 5};
-  EXPECT_THROW(pool_from_json(to_json(build.pool), {other}, "test"), Error);
-  auto broken = to_json(build.pool);
-  broken["units"][0]["patterns"][0]["keep"]["block0_a"] = {3, 1};
-  EXPECT_THROW(pool_from_json(broken, {two_groups()}, "test"), Error);
+TEST(PatternPool, KeepingPatternsNarrowsToTheWidestKept) {
+  const PatternPool pool = nested_pool({two_groups()}, {1.0, 0.5, 0.2});
+  PrunableUnit narrowed = two_groups();
+  narrowed.widths = {2, 5};
+  const PatternPool kept = keep_patterns(pool, {1, 2}, {narrowed});
+  ASSERT_EQ(kept.size(), 2);
+  EXPECT_EQ(kept.widths[0], pool.widths[1]);
+  EXPECT_EQ(kept.widths[1], pool.widths[2]);
+  EXPECT_DOUBLE_EQ(kept.channel_fraction(0), 1.0);
+  EXPECT_THROW(keep_patterns(pool, {2, 1}, {narrowed}), Error);
 }

@@ -1,8 +1,10 @@
-// Static pruning removes exactly what no frame selects, and nothing else: the smaller network
-// computes the masked union, and each kept pattern runs the same on the smaller network.
+// Static pruning keeps the widest selected pattern and nothing else: the smaller network computes
+// what that pattern computed, every other selected pattern runs the same on it, and unused
+// rendering channels and the geometry head are left out.
 #include <gtest/gtest.h>
 
-#include "pruning/pattern_executor.h"
+#include "core/error.h"
+#include "pruning/pattern_networks.h"
 #include "pruning/static_pruning.h"
 #include "tests/pruning/pruning_cases.h"
 
@@ -10,73 +12,46 @@ using namespace cgsr;
 using namespace cgsr::test;
 
 namespace {
-// Unit u never selects pattern (u % 3); the others are selected.
-std::vector<std::vector<int64_t>> counts_skipping_one(const PatternPool& pool) {
-  std::vector<std::vector<int64_t>> counts;
-  for (size_t u = 0; u < pool.units.size(); ++u) {
-    std::vector<int64_t> c(pool.units[u].patterns.size(), 2);
-    c[u % c.size()] = 0;
-    counts.push_back(c);
-  }
-  return counts;
-}
-
 torch::Tensor pick(const torch::Tensor& info, const std::vector<int64_t>& rows) {
   return info.index_select(1, torch::tensor(rows, torch::kLong));
 }
 }  // namespace
 
-TEST(StaticPruning, RemovesExactlyTheNeverSelectedChannels) {
+TEST(StaticPruning, TheStaticNetworkIsTheWidestSelectedPattern) {
   torch::manual_seed(8);
   for (const auto& c : net_cases()) {
     SCOPED_TRACE(c.name);
     SRNetwork net(c.spec);
     randomize(*net);
     net->eval();
-    const auto units = find_units(net->describe(false));
-    const PatternPool pool = random_pool(units, 3, 0.4, 21);
-    const auto counts = counts_skipping_one(pool);
+    const PatternPool pool = nested_pool(find_units(net->describe(false)), {1.0, 0.7, 0.4});
     StaticPruneOptions options;
     options.rit_threshold = 0;
-    StaticPruning pruned = static_prune(*net, pool, counts, options);
-
-    // Widths are the unions of the selected patterns; the removed lists are their complements.
-    PatternPool selected;
-    for (size_t u = 0; u < pool.units.size(); ++u) {
-      UnitPatterns s{pool.units[u].unit, {}};
-      for (size_t k = 0; k < pool.units[u].patterns.size(); ++k)
-        if (counts[u][k] > 0) s.patterns.push_back(pool.units[u].patterns[k]);
-      selected.units.push_back(s);
-      EXPECT_EQ(pruned.kept[u].size(), 2u);
-    }
-    const auto expected = selected.union_selection();
-    EXPECT_EQ(pruned.channels, expected);
-    for (const auto& [group, kept] : expected) {
-      EXPECT_EQ(pruned.network->spec().group_width(group), static_cast<int>(kept.size()));
-      const auto removed = pruned.left_out["channels"][group]["removed"].get<std::vector<int64_t>>();
-      EXPECT_EQ(removed.size() + kept.size(), static_cast<size_t>(net->spec().group_width(group)));
-      for (int64_t r : removed) EXPECT_FALSE(std::binary_search(kept.begin(), kept.end(), r));
-    }
-    // Everything else is untouched.
-    for (const auto& [group, width] : net->spec().widths.entries())
-      if (!expected.count(group)) {
-        EXPECT_EQ(pruned.network->spec().widths.at(group), width);
-      }
-
-    // The smaller network is the dense network restricted to the union...
     const auto [color, info] = inputs_for(*net, 6, 5);
+    PatternNetworks full(*net, pool);
     torch::NoGradGuard no_grad;
-    EXPECT_LT(max_diff(pruned.network->forward(color, info), masked_dense(*net, expected, color, info)), 1e-5);
-    // ...and each kept pattern computes on it what it computed on the full network.
-    PatternExecutor big(*net, pool), small(*pruned.network, pruned.pool);
-    for (int j = 0; j < 2; ++j) {
-      std::vector<int> old_choice, new_choice;
-      for (size_t u = 0; u < pool.units.size(); ++u) {
-        old_choice.push_back(pruned.kept[u][j]);
-        new_choice.push_back(j);
+
+    // Every pattern selected: the static network is the network (the union is the widest).
+    StaticPruning all = static_prune(*net, pool, {2, 1, 1}, options);
+    EXPECT_EQ(all.kept, (std::vector<int>{0, 1, 2}));
+    EXPECT_EQ(all.network->spec().widths, net->spec().widths);
+    EXPECT_LT(max_diff(all.network->forward(color, info), net->forward(color, info)), 1e-5);
+
+    // The widest never selected: it goes, and the next one is the static network.
+    StaticPruning pruned = static_prune(*net, pool, {0, 3, 2}, options);
+    EXPECT_EQ(pruned.kept, (std::vector<int>{1, 2}));
+    for (const auto& u : pool.units)
+      for (const auto& g : u.groups) {
+        EXPECT_EQ(pruned.network->spec().group_width(g), pool.widths[1].at(g));
+        EXPECT_EQ(pruned.channels.at(g).size(), static_cast<size_t>(pool.widths[1].at(g)));
       }
-      EXPECT_LT(max_diff(small.run(color, info, new_choice), big.run(color, info, old_choice)), 1e-5);
-    }
+    EXPECT_LT(max_diff(pruned.network->forward(color, info), full.run(1, color, info)), 1e-4);
+    PatternNetworks small(*pruned.network, pruned.pool);
+    ASSERT_EQ(small.size(), 2);
+    EXPECT_LT(max_diff(small.run(1, color, info), full.run(2, color, info)), 1e-4);
+    EXPECT_EQ(pruned.left_out["patterns"]["kept"].get<std::vector<int>>(), (std::vector<int>{1, 2}));
+
+    EXPECT_THROW(static_prune(*net, pool, {0, 0, 0}, options), Error);
   }
 }
 
@@ -94,11 +69,8 @@ TEST(StaticPruning, LeavesOutUnusedRenderingChannelsAndTheGeometryHead) {
     net->rit_gate().fill_(1.0f);
     net->rit_gate()[1] = 0.0f;
   }
-  const auto units = find_units(net->describe(false));
-  const PatternPool pool = random_pool(units, 2, 1.0, 1);  // keep everything
-  std::vector<std::vector<int64_t>> counts;
-  for (const auto& u : pool.units) counts.push_back(std::vector<int64_t>(u.patterns.size(), 1));
-  StaticPruning pruned = static_prune(*net, pool, counts, StaticPruneOptions{});
+  const PatternPool pool = nested_pool(find_units(net->describe(false)), {1.0, 0.5});
+  StaticPruning pruned = static_prune(*net, pool, {1, 1}, StaticPruneOptions{});
   EXPECT_EQ(pruned.rit_channels_dropped, (std::vector<std::string>{"normal_angle"}));
   EXPECT_EQ(pruned.network->spec().rit.channels, (std::vector<std::string>{"depth", "edge"}));
   EXPECT_FALSE(pruned.network->has_geometry_head());

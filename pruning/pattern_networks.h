@@ -1,0 +1,50 @@
+#pragma once
+// The patterns of a pool (pattern_pool.h) as networks that run: pattern k is the network's graph
+// narrowed to the first channels of every unit group, its weights leading slices (views) of the
+// widest weights (gathered only along an axis that concatenates unit groups, such as PAN's
+// conv3 input), executed by cgsr's fast path (models/fused_graph.h) like any static network.
+// Choosing a pattern per frame costs nothing beyond running that pattern: no weights move.
+//
+//   PatternNetworks patterns(*net, pool);
+//   auto sr = patterns.run(2, lr_color, net->info_input(batch));   // pattern 2 of the pool
+
+#include <torch/types.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/timing.h"
+#include "models/complexity.h"
+#include "models/fused_graph.h"
+#include "models/graph.h"
+#include "models/sr_network.h"
+#include "pruning/pattern_pool.h"
+
+namespace cgsr {
+
+class PatternNetworks {
+ public:
+  // Reads `net`'s weights now (later changes to the network are not seen). The pool must
+  // belong to the network (its units).
+  PatternNetworks(const SRNetworkImpl& net, PatternPool pool);
+  ~PatternNetworks();
+
+  int size() const { return pool_.size(); }
+  const PatternPool& pool() const { return pool_; }
+
+  // The narrowed graph of pattern k; its tensors are views of the widest graph's.
+  const graph::Graph& graph(int k) const;
+  // [N, 3, s*h, s*w]; `info` as for SRNetworkImpl::forward (undefined without RIT). No autograd.
+  torch::Tensor run(int k, const torch::Tensor& lr_color, const torch::Tensor& info);
+  Complexity cost(int k, int64_t lr_width, int64_t lr_height) const;
+
+  // Every pattern timed on one input in interleaved rounds (after two warm-up runs each).
+  std::vector<LatencyStats> measure_latency(const torch::Tensor& lr_color, const torch::Tensor& info, int rounds);
+
+ private:
+  PatternPool pool_;
+  std::vector<graph::Graph> graphs_;
+  std::vector<std::unique_ptr<FusedGraph>> fused_;  // built on first use
+};
+
+}  // namespace cgsr
