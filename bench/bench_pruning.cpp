@@ -4,11 +4,12 @@
 // hits all alike. Every target runs on cgsr's fast path (models/fused_graph.h).
 //
 //   bench_pruning --model runs/quickstart/prune/pruned.cgsr --data runs/quickstart/data \
-//     [--split test] [--rounds N] [--threads N]
+//     [--baseline runs/quickstart/prune/baseline0_magnitude.cgsr ...] [--split test] [--rounds N] [--threads N]
 //
 // Prints, per target, mean, median and p95 per frame and the mean against the static network's:
-// the static network (the widest pattern), each pattern alone, and the hybrid model (choosing
-// and running, frame after frame); then how often the hybrid chose each pattern.
+// the static network (the widest pattern), each pattern alone, each --baseline model (a static
+// network at the hybrid's mean MACs, the control), and the hybrid model (choosing and running,
+// frame after frame); then how often the hybrid chose each pattern.
 #include <torch/torch.h>
 
 #include <cstdio>
@@ -17,6 +18,7 @@
 
 #include "core/runtime.h"
 #include "core/timing.h"
+#include "models/model_file.h"
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
 #include "render_data/patch_sampler.h"
@@ -27,6 +29,7 @@ using namespace cgsr;
 int main(int argc, char** argv) {
   int rounds = 20, threads = 0;
   std::string model_path, data_path, split = "test";
+  std::vector<std::string> baseline_paths;
   bool usage = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -37,13 +40,15 @@ int main(int argc, char** argv) {
     if (arg == "--rounds") rounds = std::stoi(value());
     else if (arg == "--model") model_path = value();
     else if (arg == "--data") data_path = value();
+    else if (arg == "--baseline") baseline_paths.push_back(value());
     else if (arg == "--split") split = value();
     else if (arg == "--threads") threads = std::stoi(value());
     else usage = true;
   }
   if (usage || model_path.empty() || data_path.empty()) {
     std::fprintf(stderr,
-                 "usage: bench_pruning --model pruned.cgsr --data DATA_DIR [--split test] [--rounds N] [--threads N]\n");
+                 "usage: bench_pruning --model pruned.cgsr --data DATA_DIR [--baseline MODEL ...] [--split test] [--rounds N] "
+                 "[--threads N]\n");
     return 2;
   }
   set_threads(threads);
@@ -58,28 +63,42 @@ int main(int argc, char** argv) {
   for (int f : frames) batches.push_back(frame_batch(data, f, scale, hybrid.channels(), hybrid.depth_encoding()));
   PatternNetworks patterns(*model.network, model.pool);
 
+  // Every target runs the frames in turn; run(i) upscales frame i of the sequence.
   struct Target {
     std::string name;
-    std::function<void(const Batch&)> run;
+    std::function<void(size_t)> run;
   };
-  std::vector<Target> targets = {{"static network", [&](const Batch& b) {
-                                    patterns.run(0, b.lr_color, model.network->info_input(b));
+  std::vector<Target> targets = {{"static network", [&](size_t i) {
+                                    patterns.run(0, batches[i].lr_color, model.network->info_input(batches[i]));
                                   }}};
   for (int k = 1; k < patterns.size(); ++k)
-    targets.push_back({"pattern " + std::to_string(k) + " alone", [&, k](const Batch& b) {
-                         patterns.run(k, b.lr_color, model.network->info_input(b));
+    targets.push_back({"pattern " + std::to_string(k) + " alone", [&, k](size_t i) {
+                         patterns.run(k, batches[i].lr_color, model.network->info_input(batches[i]));
                        }});
-  targets.push_back({"hybrid (choose + run)", [&](const Batch& b) { hybrid.upscale(b); }});
+  // A baseline may read other rendering channels than the hybrid: its own batches of the frames.
+  std::vector<std::unique_ptr<NetworkUpscaler>> baselines;
+  std::vector<std::vector<Batch>> baseline_batches;
+  for (const auto& path : baseline_paths) {
+    Model m = load_model(path);
+    const std::string name = m.provenance.extra.value("name", std::filesystem::path(path).stem().string());
+    baselines.push_back(std::make_unique<NetworkUpscaler>(name, m.network));
+    baseline_batches.emplace_back();
+    for (int f : frames)
+      baseline_batches.back().push_back(
+          frame_batch(data, f, scale, baselines.back()->channels(), baselines.back()->depth_encoding()));
+  }
+  for (size_t b = 0; b < baselines.size(); ++b)
+    targets.push_back({baselines[b]->name(), [&, b](size_t i) { baselines[b]->upscale(baseline_batches[b][i]); }});
+  targets.push_back({"hybrid (choose + run)", [&](size_t i) { hybrid.upscale(batches[i]); }});
   std::vector<std::function<void()>> runs;
-  for (const auto& t : targets)
-    runs.push_back([&, next = size_t{0}]() mutable { t.run(batches[next++ % batches.size()]); });
+  for (const auto& t : targets) runs.push_back([&, next = size_t{0}]() mutable { t.run(next++ % batches.size()); });
   const auto stats = measure_latency_interleaved(runs, /*warmup=*/static_cast<int>(batches.size()),
                                                  rounds * static_cast<int>(batches.size()));
   std::printf("%s: %zu %s frames in turn, %d threads, %d rounds\n", model_path.c_str(), batches.size(), split.c_str(),
               thread_count(), rounds);
-  std::printf("%-24s %10s %10s %10s %10s\n", "target", "mean ms", "p50 ms", "p95 ms", "mean/static");
+  std::printf("%-32s %10s %10s %10s %10s\n", "target", "mean ms", "p50 ms", "p95 ms", "mean/static");
   for (size_t i = 0; i < targets.size(); ++i)
-    std::printf("%-24s %10.2f %10.2f %10.2f %10.3f\n", targets[i].name.c_str(), stats[i].mean_ms, stats[i].median_ms,
+    std::printf("%-32s %10.2f %10.2f %10.2f %10.3f\n", targets[i].name.c_str(), stats[i].mean_ms, stats[i].median_ms,
                 stats[i].p95_ms, stats[i].mean_ms / stats.front().mean_ms);
   std::printf("hybrid's patterns chosen:");
   for (size_t k = 0; k < hybrid.usage().size(); ++k) std::printf(" %zu: %lld", k, static_cast<long long>(hybrid.usage()[k]));

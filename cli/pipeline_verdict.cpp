@@ -5,6 +5,8 @@
 #include <map>
 #include <optional>
 
+#include "train/pattern_choice.h"
+
 namespace cgsr::cli {
 
 config::Schema<VerdictOptions> verdict_schema() {
@@ -114,15 +116,11 @@ void check_dynamic_pruning(Verdict& v, const EvalResult& hybrid, const EvalResul
                      magnitude->psnr, gain, hybrid.cost ? static_cast<double>(hybrid.cost->macs) : 0.0,
                      magnitude->cost ? static_cast<double>(magnitude->cost->macs) : 0.0)});
   }
-  std::map<int, int> used;
-  for (const auto& f : hybrid.frames)
-    if (f.details.is_object() && f.details.contains("pattern")) ++used[f.details["pattern"].get<int>()];
-  std::string shares;
-  for (const auto& [k, n] : used) shares += fmt::format("{}pattern {}: {} frames", shares.empty() ? "" : ", ", k, n);
+  const auto choices = pattern_choices(hybrid);
+  const int used = choices ? static_cast<int>(choices->usage.size()) : 0;
   v.checks.push_back({fmt::format("{} uses at least {} patterns on the test frames", hybrid.name,
                                   options.min_patterns_used),
-                      static_cast<int>(used.size()) >= options.min_patterns_used,
-                      used.empty() ? "no frame recorded a pattern" : shares});
+                      used >= options.min_patterns_used, choices ? usage_text(*choices) : "no frame recorded a pattern"});
 }
 
 }  // namespace

@@ -10,11 +10,6 @@
 
 namespace cgsr {
 
-const std::vector<std::string>& EnumNames<ImportanceMethod>::names() {
-  static const std::vector<std::string> names = {"taylor", "activation"};
-  return names;
-}
-
 std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::vector<PrunableUnit>& units) {
   std::set<std::string> dynamic;
   for (const auto& u : units) dynamic.insert(u.groups.begin(), u.groups.end());
@@ -35,7 +30,7 @@ std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::v
 }
 
 FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<PrunableUnit>& units,
-                                 ImportanceMethod method) {
+                                 ActivationScore score) {
   const graph::Graph g = net.describe(false);
   const auto producers = conv_input_producers(g, units);
   std::set<std::string> dynamic;
@@ -44,7 +39,7 @@ FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const s
   std::vector<std::pair<size_t, torch::Tensor>> captured;  // (op index, value)
   std::vector<bool> wanted(g.ops.size(), false);
   for (size_t i : producers) wanted[i] = true;
-  const bool taylor = method == ImportanceMethod::Taylor;
+  const bool taylor = score == ActivationScore::Taylor;
   const graph::OpObserver observe = [&](size_t index, const torch::Tensor& y) {
     if (wanted[index]) {
       if (taylor) y.retain_grad();

@@ -1,6 +1,6 @@
 #pragma once
 // How much each channel of the pruning units matters for one input (a training frame): the
-// per-frame ranking that frequency-based sorting (pattern_pool.h) counts.
+// per-frame ranking that orders the channels of the pattern pool (pattern_pool.h).
 //
 //   taylor      |sum over the values carrying c (as convolution inputs) of sum_pixels a * dL/da|:
 //               the first-order change of the reconstruction loss L (mean squared error to the
@@ -17,16 +17,13 @@
 
 namespace cgsr {
 
-enum class ImportanceMethod { Taylor, Activation };
-template <>
-struct EnumNames<ImportanceMethod> {
-  static constexpr const char* kind = "importance";
-  static const std::vector<std::string>& names();  // taylor, activation
-};
+// What is scored per activation: a * dL/da (Taylor) or |a|.
+enum class ActivationScore { Taylor, MeanAbsolute };
 
 // For every group of `units`: importance [width] (CPU float) under the batch (summed over items).
+// The registry in importance.h is the interface the pruner uses.
 FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<PrunableUnit>& units,
-                                 ImportanceMethod method);
+                                 ActivationScore score);
 
 // Op indices whose outputs feed a convolution and carry channels of `units`' groups: the values
 // where removing a channel takes effect (masks and importance apply there).

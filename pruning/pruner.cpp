@@ -6,22 +6,62 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/progress.h"
-#include "pruning/activation_importance.h"
 #include "pruning/hybrid_upscaler.h"
-#include "pruning/magnitude_pruning.h"
 #include "pruning/pattern_networks.h"
 #include "render_data/patch_sampler.h"
 
 namespace cgsr {
 
-namespace {
-std::vector<int> spread(const std::vector<int>& frames, int count) {
-  if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
-  std::vector<int> out;
-  for (int i = 0; i < count; ++i) out.push_back(frames[i * frames.size() / count]);
-  return out;
+const PrunedBaseline* PruneRoles::baseline(const std::string& type) const {
+  for (const auto& b : baselines)
+    if (b.options.type == type) return &b;
+  return nullptr;
 }
 
+nlohmann::ordered_json to_json(const PruneRoles& roles) {
+  const auto model = [](const PrunedModel& m) {
+    return nlohmann::ordered_json{{"name", m.name}, {"file", m.file.string()}};
+  };
+  nlohmann::ordered_json j;
+  j["input"] = model(roles.input);
+  j["hybrid"] = model(roles.hybrid);
+  j["static"] = model(roles.static_network);
+  j["baselines"] = nlohmann::ordered_json::array();
+  for (const auto& b : roles.baselines) {
+    auto entry = model(b);
+    entry["type"] = b.options.type;
+    entry["requested_keep_rate"] = b.options.keep_rate;
+    entry["keep_rate"] = b.keep_rate;
+    j["baselines"].push_back(entry);
+  }
+  return j;
+}
+
+PruneRoles prune_roles_from_json(const nlohmann::ordered_json& j, const std::string& where) {
+  const auto model = [](const nlohmann::ordered_json& m, PrunedModel& out) {
+    out.name = m.at("name").get<std::string>();
+    out.file = m.at("file").get<std::string>();
+  };
+  PruneRoles roles;
+  try {
+    model(j.at("input"), roles.input);
+    model(j.at("hybrid"), roles.hybrid);
+    model(j.at("static"), roles.static_network);
+    for (const auto& b : j.at("baselines")) {
+      PrunedBaseline baseline;
+      model(b, baseline);
+      baseline.options.type = b.at("type").get<std::string>();
+      baseline.options.keep_rate = b.at("requested_keep_rate").get<double>();
+      baseline.keep_rate = b.at("keep_rate").get<double>();
+      roles.baselines.push_back(baseline);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(where, std::string("malformed prune roles (run cgsr prune again): ") + e.what());
+  }
+  return roles;
+}
+
+namespace {
 // Ratios of a model's figures to the input model's (same frames, same process).
 nlohmann::ordered_json against(const EvalResult& r, const EvalResult& base) {
   nlohmann::ordered_json j;
@@ -36,21 +76,27 @@ nlohmann::ordered_json against(const EvalResult& r, const EvalResult& base) {
   return j;
 }
 
+// Per frame of `frames`, the importance of every unit channel of `net` under `method`.
+std::vector<FrameImportance> importance_on(SRNetworkImpl& net, const Dataset& data, const std::vector<int>& frames,
+                                           const std::string& method) {
+  const auto units = find_units(net.describe(false));
+  const auto& score = importance_methods().get(method);
+  std::vector<FrameImportance> out;
+  Progress progress("importance (" + method + ")", static_cast<int64_t>(frames.size()));
+  for (int f : frames) {
+    out.push_back(score(net, frame_batch(data, f, net.spec().scale, net.input_channels(), net.depth_encoding()), units));
+    progress.advance();
+  }
+  progress.finish();
+  return out;
+}
+
 // Step 1: the input network with its unit channels in order of importance on `frames`, and the
 // pool of nested patterns over it.
 std::pair<SRNetwork, PatternPool> ordered_network(SRNetworkImpl& net, const Dataset& data, const std::vector<int>& frames,
                                                   const PruneOptions& options) {
-  const int scale = net.spec().scale;
   const auto units = find_units(net.describe(false));
-  const auto method = enum_from_name<ImportanceMethod>(options.importance);
-  std::vector<FrameImportance> importance;
-  Progress progress("importance", static_cast<int64_t>(frames.size()));
-  for (int f : frames) {
-    importance.push_back(
-        frame_importance(net, frame_batch(data, f, scale, net.input_channels(), net.depth_encoding()), units, method));
-    progress.advance();
-  }
-  progress.finish();
+  const auto importance = importance_on(net, data, frames, options.importance);
   SRNetwork ordered = order_channels(net, importance_order(units, importance)).network;
   PatternPool pool = nested_pool(find_units(ordered->describe(false)), options.pool.keep_rates);
   return {ordered, pool};
@@ -74,6 +120,65 @@ HybridModel hybrid_model(DynamicPruning& dynamic, const std::vector<int64_t>& co
     hybrid.latency.median_ms.push_back(l.median_ms);
   return hybrid;
 }
+
+// The MACs of the hybrid model's choices on the training frames, averaged per frame.
+double mean_chosen_macs(const HybridModel& hybrid, const StaticPruning& pruned, const std::vector<int64_t>& counts,
+                        const Resolution& lr) {
+  PatternNetworks patterns(*hybrid.network, hybrid.pool);
+  double macs = 0;
+  int64_t chosen = 0;
+  for (size_t i = 0; i < pruned.kept.size(); ++i) {
+    const int64_t n = counts[pruned.kept[i]];
+    macs += static_cast<double>(n) * static_cast<double>(patterns.cost(static_cast<int>(i), lr.width, lr.height).macs);
+    chosen += n;
+  }
+  return macs / static_cast<double>(std::max<int64_t>(1, chosen));
+}
+
+// What every static baseline of one prune run shares.
+struct BaselineContext {
+  std::filesystem::path model_path;  // the input model
+  const Dataset& data;
+  std::vector<int> frames;  // the frames that rank channels
+  TrainSchedule schedule;   // the hybrid model's fine-tuning steps
+  LossOptions loss;
+  std::filesystem::path out;
+  bool resume = false;
+  Provenance provenance;  // extra.name: the input model's display name
+};
+
+// Step 5: one static baseline of the input network, at its own rate or at `macs`, fine-tuned
+// like the hybrid model (resumable from its checkpoint); its training outcome goes to `training`.
+PrunedBaseline prune_baseline(const BaselineContext& c, const BaselineOptions& options, size_t index, double macs,
+                              nlohmann::ordered_json& training) {
+  Model input = load_model(c.model_path);
+  SRNetworkImpl& net = *input.network;
+  const Resolution lr = c.data.resolutions()[resolution_pair(c.data, net.spec().scale).first];
+  PrunedBaseline b;
+  b.options = options;
+  b.keep_rate = options.keep_rate > 0 ? options.keep_rate
+                                      : keep_rate_for_macs(net, static_cast<int64_t>(macs), lr.width, lr.height);
+  b.name = c.provenance.extra.at("name").get<std::string>() + " " + baseline_label(options);
+  const std::string stem = "baseline" + std::to_string(index) + "_" + options.type;
+  b.file = c.out / (stem + ".cgsr");
+  // A frame-independent method needs one frame.
+  const auto ranked = options.type == "magnitude" ? std::vector<int>{c.frames.front()} : c.frames;
+  const auto order = importance_order(find_units(net.describe(false)), importance_on(net, c.data, ranked, options.type));
+  Inheritance pruned = prune_to_rate(net, order, b.keep_rate);
+  spdlog::info("fine-tuning the {} baseline ({}, keep rate {:.3f}): {} steps", options.type,
+               spec_summary(pruned.network->spec()), b.keep_rate, c.schedule.steps);
+  Trainer trainer(pruned.network, c.data, c.schedule, c.loss);
+  const TrainOutcome outcome = trainer.run(c.out / ("finetune_" + stem + ".pt"), c.resume);
+  Provenance p = c.provenance;
+  p.stage = "pruned-baseline";
+  p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
+  p.extra["name"] = b.name;
+  p.extra["baseline"] = options.type;
+  p.extra["keep_rate"] = b.keep_rate;
+  save_model(b.file, *pruned.network, p);
+  training[stem] = to_json(outcome);
+  return b;
+}
 }  // namespace
 
 nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Dataset& data, const PruneOptions& options,
@@ -90,9 +195,11 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   if (train_frames.empty()) throw Error(data.info().root.string(), "the data set has no training frames");
   spdlog::info("pruning {} ({}): {} patterns of keep rates {}", name, spec_summary(input.network->spec()),
                options.pool.keep_rates.size(), nlohmann::json(options.pool.keep_rates).dump());
+  PruneRoles roles;
+  roles.input = {name, model_path};
 
   // 1. Channels in order of importance, nested patterns.
-  const auto pool_frames = spread(train_frames, options.pool_frames);
+  const auto pool_frames = spread_frames(train_frames, options.pool_frames);
   auto [net, pool] = ordered_network(*input.network, data, pool_frames, options);
   write_file_atomic(out / "pool.json", to_json(pool).dump(1));
 
@@ -106,7 +213,7 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   const TrainOutcome hybrid_training = finetune.run(out / "finetune_hybrid.pt", resume);
 
   // 3. The per-frame choice.
-  const SelectorFit fit = dynamic.fit_selector(spread(train_frames, options.selector.frames), options.selector);
+  const SelectorFit fit = dynamic.fit_selector(spread_frames(train_frames, options.selector.frames), options.selector);
   spdlog::info("pattern choice fitted: mean cost {:.3f} of the widest (budget {}), {:.0f}% of the frames' cheapest "
                "patterns chosen",
                fit.mean_cost, options.selector.budget, 100 * fit.agreement);
@@ -121,20 +228,11 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   hybrid.provenance.metrics = {{"val_psnr", hybrid_training.best.psnr}, {"val_ssim", hybrid_training.best.ssim}};
   hybrid.provenance.extra = {{"name", name + " hybrid"}, {"data", data.info().root.string()},
                              {"left_out", pruned.left_out}};
-  const auto hybrid_path = out / "pruned.cgsr";
-  save_hybrid_model(hybrid_path, hybrid);
-
-  // Mean MACs of the hybrid model's choices on the training frames.
+  roles.hybrid = {name + " hybrid", out / "pruned.cgsr"};
+  roles.static_network = {name + " static", roles.hybrid.file};
+  save_hybrid_model(roles.hybrid.file, hybrid);
   const Resolution lr = data.resolutions()[resolution_pair(data, scale).first];
-  PatternNetworks static_patterns(*hybrid.network, hybrid.pool);
-  double mean_macs = 0;
-  int64_t chosen = 0;
-  for (size_t i = 0; i < pruned.kept.size(); ++i) {
-    const int64_t n = counts[pruned.kept[i]];
-    mean_macs += static_cast<double>(n) * static_cast<double>(static_patterns.cost(static_cast<int>(i), lr.width, lr.height).macs);
-    chosen += n;
-  }
-  mean_macs /= static_cast<double>(std::max<int64_t>(1, chosen));
+  const double mean_macs = mean_chosen_macs(hybrid, pruned, counts, lr);
 
   nlohmann::ordered_json results;
   results["model"] = where;
@@ -153,50 +251,34 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   results["mean_macs_train"] = mean_macs;
   results["left_out"] = pruned.left_out;
   results["finetune"] = {{"steps", schedule.steps}, {"hybrid", to_json(hybrid_training)}};
-  results["files"] = {{"hybrid", hybrid_path.string()}, {"pool", (out / "pool.json").string()}};
 
-  // 5. The magnitude pruning baseline at the hybrid model's mean MACs, same steps.
-  Model original = load_model(model_path);
-  std::optional<SRNetwork> mmp;
-  if (options.magnitude_baseline) {
-    const double rate = magnitude_rate_for_macs(*original.network, static_cast<int64_t>(mean_macs), lr.width, lr.height);
-    Inheritance baseline = magnitude_prune(*original.network, rate);
-    spdlog::info("fine-tuning the magnitude pruning baseline ({}, keep rate {:.3f}): {} steps",
-                 spec_summary(baseline.network->spec()), rate, schedule.steps);
-    Trainer trainer(baseline.network, data, schedule, options.finetune.loss);
-    const TrainOutcome outcome = trainer.run(out / "finetune_mmp.pt", resume);
-    Provenance p;
-    p.stage = "pruned-magnitude";
-    p.parent = where;
-    p.config = config;
-    p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
-    p.extra = {{"name", name + " MMP"}, {"data", data.info().root.string()}, {"keep_rate", rate}};
-    save_model(out / "mmp.cgsr", *baseline.network, p);
-    results["finetune"]["mmp"] = to_json(outcome);
-    results["files"]["mmp"] = (out / "mmp.cgsr").string();
-    results["mmp_keep_rate"] = rate;
-    mmp = baseline.network;
-  }
+  // 5. The static baselines, at the hybrid model's mean MACs unless given a rate, same steps.
+  BaselineContext context{model_path, data, pool_frames, schedule, options.finetune.loss, out, resume, {}};
+  context.provenance.parent = where;
+  context.provenance.config = config;
+  context.provenance.extra = {{"name", name}, {"data", data.info().root.string()}};
+  for (size_t i = 0; i < options.baselines.size(); ++i)
+    roles.baselines.push_back(prune_baseline(context, options.baselines[i], i, mean_macs, results["finetune"]));
+  results["roles"] = to_json(roles);
+
   // 6. Held-out evaluation through the same code path as `cgsr eval`.
   std::vector<EvalResult> evaluations;
   {
-    NetworkUpscaler dense(name, original.network);
+    NetworkUpscaler dense(name, load_model(model_path).network);
     evaluations.push_back(evaluate(dense, data, options.eval));
   }
-  if (mmp) {
-    NetworkUpscaler baseline(name + " MMP", *mmp);
+  for (const auto& b : roles.baselines) {
+    NetworkUpscaler baseline(b.name, load_model(b.file).network);
     evaluations.push_back(evaluate(baseline, data, options.eval));
   }
   {
-    NetworkUpscaler static_only(name + " static", pruned.network);
+    NetworkUpscaler static_only(roles.static_network.name, pruned.network);
     evaluations.push_back(evaluate(static_only, data, options.eval));
   }
   {
-    HybridUpscaler from_file(name + " hybrid", load_hybrid_model(hybrid_path));
+    HybridUpscaler from_file(roles.hybrid.name, load_hybrid_model(roles.hybrid.file));
     evaluations.push_back(evaluate(from_file, data, options.eval));
-    std::vector<int64_t> usage(hybrid.pool.size(), 0);
-    for (const auto& f : evaluations.back().frames) ++usage.at(f.details.at("pattern").get<int>());
-    results["test_selected_per_pattern"] = usage;
+    results["test_selected_per_pattern"] = from_file.usage();
   }
   results["evaluations"] = nlohmann::ordered_json::array();
   results["comparison"] = nlohmann::ordered_json::array();

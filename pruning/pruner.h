@@ -8,12 +8,15 @@
 //      does not cost the frame quality, within the budget (dynamic_pruning.h)
 //   4. static pruning of the patterns no training frame selects (static_pruning.h), and the
 //      latency table of the remaining ones
-//   5. the magnitude pruning baseline at the hybrid model's mean MACs on the training frames,
-//      fine-tuned with the same number of steps
-//   6. evaluation of the input model, the baseline, the static network alone and the hybrid
+//   5. the static baselines (baseline_pruning.h; magnitude pruning by default), each at the
+//      hybrid model's mean MACs on the training frames unless given a rate, fine-tuned with the
+//      same number of steps
+//   6. evaluation of the input model, the baselines, the static network alone and the hybrid
 //      model on held-out frames, through the same evaluate() as `cgsr eval`
-// Writes <out>/pruned.cgsr (hybrid; plain load_model() reads its static network), mmp.cgsr,
-// pool.json, and returns the results (the `evaluations` list feeds `cgsr report`).
+// Writes <out>/pruned.cgsr (hybrid; plain load_model() reads its static network), one
+// baseline<i>_<type>.cgsr per baseline and pool.json, and returns the results: `roles` says
+// which evaluated model is which and where its file is (PruneRoles), and the `evaluations`
+// list feeds `cgsr report`.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -23,8 +26,10 @@
 
 #include "core/config.h"
 #include "models/model_file.h"
+#include "pruning/baseline_pruning.h"
 #include "pruning/dynamic_pruning.h"
 #include "pruning/dynamic_sampler.h"
+#include "pruning/importance.h"
 #include "pruning/pattern_pool.h"
 #include "pruning/static_pruning.h"
 #include "render_data/dataset.h"
@@ -34,16 +39,38 @@ namespace cgsr {
 
 struct PruneOptions {
   std::string name;                 // display name of the input model (default: recorded name or file stem)
-  std::string importance = "taylor";  // taylor | activation
+  std::string importance = "taylor";  // a method of importance.h
   int pool_frames = 0;              // training frames whose importance orders the channels (0 = all)
   PoolOptions pool;
   SamplerOptions sampler;
   FinetuneOptions finetune;
   SelectorOptions selector;
   StaticPruneOptions static_prune;
-  bool magnitude_baseline = true;
+  std::vector<BaselineOptions> baselines = {BaselineOptions{}};
   EvalOptions eval;                 // held-out evaluation of every model
 };
+
+// Which evaluated model of a prune run is which, and its file: callers join results by role,
+// never by display name.
+struct PrunedModel {
+  std::string name;            // display name in the evaluations
+  std::filesystem::path file;  // its model file
+};
+struct PrunedBaseline : PrunedModel {
+  BaselineOptions options;
+  double keep_rate = 0;  // the rate used (matched to the hybrid's MACs when options.keep_rate is 0)
+};
+struct PruneRoles {
+  PrunedModel input;                     // the network that was pruned
+  PrunedModel hybrid;                    // the hybrid model (pruned.cgsr)
+  PrunedModel static_network;            // its static network alone (the same file, load_model)
+  std::vector<PrunedBaseline> baselines;
+  // The first baseline of `type`, or null.
+  const PrunedBaseline* baseline(const std::string& type) const;
+};
+nlohmann::ordered_json to_json(const PruneRoles& roles);
+// `where` names the results file in errors.
+PruneRoles prune_roles_from_json(const nlohmann::ordered_json& j, const std::string& where);
 
 // Binds the PruneOptions fields of an options struct T deriving from PruneOptions (a command's)
 // at the top level of its config, next to T's own keys.
@@ -54,8 +81,8 @@ void add_prune_fields(config::Schema<T>& s) {
     return static_cast<V T::*>(member);
   };
   s.field("name", m(&PruneOptions::name), "display name of the input model in reports (default: the recorded one)");
-  s.field("importance", m(&PruneOptions::importance), "per-frame channel importance for the pattern pool")
-      .one_of({"taylor", "activation"});
+  s.field("importance", m(&PruneOptions::importance), "channel importance that orders the pattern pool's channels")
+      .one_of(importance_methods().names());
   s.field("pool_frames", m(&PruneOptions::pool_frames),
           "training frames whose channel importance orders the channels (0 = all)")
       .at_least(0);
@@ -65,8 +92,8 @@ void add_prune_fields(config::Schema<T>& s) {
             "fine-tuning of every pattern with L_p (Eq. 4, sandwich rule)");
   s.section("selector", m(&PruneOptions::selector), selector_schema(), "fitting the per-frame pattern choice");
   s.section("static", m(&PruneOptions::static_prune), static_prune_schema(), "static pruning");
-  s.field("magnitude_baseline", m(&PruneOptions::magnitude_baseline),
-          "also prune by L1 magnitude to the hybrid model's mean MACs, fine-tuned with the same steps (MMP)");
+  s.list("baselines", m(&PruneOptions::baselines), baseline_schema(),
+         "static pruning baselines, fine-tuned with the same steps (default: magnitude pruning at the hybrid's MACs)");
   s.section("eval", m(&PruneOptions::eval), eval_schema_fields(), "held-out evaluation of every model");
 }
 

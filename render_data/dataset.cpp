@@ -225,6 +225,13 @@ std::vector<int> Dataset::frames(Split split) const {
   return all;
 }
 
+std::vector<int> spread_frames(const std::vector<int>& frames, int count) {
+  if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
+  std::vector<int> out;
+  for (int i = 0; i < count; ++i) out.push_back(frames[i * frames.size() / count]);
+  return out;
+}
+
 Frame Dataset::load(int index, size_t resolution) const { return impl_->load(index, resolution); }
 
 std::shared_ptr<const Frame> Dataset::frame(int index, size_t resolution) const {

@@ -97,6 +97,9 @@ class Dataset {
   std::shared_ptr<Impl> impl_;
 };
 
+// At most `count` frames spread evenly over `frames`, in order (count <= 0: all of them).
+std::vector<int> spread_frames(const std::vector<int>& frames, int count);
+
 // Loader entry points (dataset.cpp registers them).
 std::unique_ptr<FrameSource> open_cgsr_dataset(const std::filesystem::path& root, const DatasetOpenOptions& options);
 std::unique_ptr<FrameSource> open_cgsr_release(const std::filesystem::path& root, const DatasetOpenOptions& options);

@@ -123,14 +123,6 @@ struct NchwOnExit {
   torch::nn::Module& module;
   ~NchwOnExit() { set_parameter_layout(module, MemoryLayout::Nchw); }
 };
-
-// Frames spread evenly over `frames`, at most `count` (0 = all).
-std::vector<int> spread(const std::vector<int>& frames, int count) {
-  if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
-  std::vector<int> out;
-  for (int i = 0; i < count; ++i) out.push_back(frames[i * frames.size() / count]);
-  return out;
-}
 }  // namespace
 
 Trainer::Trainer(SRNetwork network, const Dataset& data, TrainSchedule schedule, LossOptions loss, ShrinkTargets shrink,
@@ -142,8 +134,8 @@ Trainer::Trainer(SRNetwork network, const Dataset& data, TrainSchedule schedule,
       shrink_(std::move(shrink)),
       hooks_(std::move(hooks)),
       channels_(network_->input_channels()) {
-  val_frames_ = spread(data_.frames(Split::Val), schedule_.val_frames);
-  if (val_frames_.empty()) val_frames_ = spread(data_.frames(Split::Train), std::max(1, schedule_.val_frames));
+  val_frames_ = spread_frames(data_.frames(Split::Val), schedule_.val_frames);
+  if (val_frames_.empty()) val_frames_ = spread_frames(data_.frames(Split::Train), std::max(1, schedule_.val_frames));
   if (data_.frames(Split::Train).empty())
     throw Error(data_.info().root.string(), "the data set has no training frames");
 }

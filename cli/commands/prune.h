@@ -1,8 +1,9 @@
 #pragma once
 // `cgsr prune`: hybrid pruning of a trained model for one scene (pruning/pruner.h). Writes
-// pruned.cgsr (the statically pruned network with its dynamic pruning components), mmp.cgsr (the
-// magnitude pruning baseline), pool.json, fine-tuning checkpoints (for --resume) and
-// results.json, whose `evaluations` (input model, baseline, static, hybrid) feed `cgsr report`.
+// pruned.cgsr (the statically pruned network with its dynamic pruning component), one
+// baseline<i>_<type>.cgsr per static baseline (magnitude pruning by default), pool.json,
+// fine-tuning checkpoints (for --resume) and results.json: `roles` names each model and its
+// file, and `evaluations` (input model, baselines, static, hybrid) feed `cgsr report`.
 
 #include <CLI/CLI.hpp>
 

@@ -1,9 +1,11 @@
 #include "cli/commands/report.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "train/pattern_choice.h"
 
 namespace cgsr::cli {
 
@@ -66,6 +68,22 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
     write_report_plot(run_dir.file(plot), t);
     markdown += "![PSNR against latency](" + plot + ")\n\n";
     results["tables"].push_back({{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}});
+    // Models that choose a pattern per frame: the choice next to each frame's edge density.
+    for (size_t i = 0; i < t.rows.size(); ++i) {
+      const auto choices = pattern_choices(t.rows[i]);
+      if (!choices) continue;
+      std::string choice_plot = "pattern_choice_" + t.dataset + "_x" + std::to_string(t.scale) + "_" +
+                                std::to_string(i + 1) + ".png";
+      const bool has_edges = std::any_of(choices->frames.begin(), choices->frames.end(),
+                                         [](const FrameChoice& c) { return c.edge_fraction.has_value(); });
+      if (has_edges)
+        write_pattern_choice_plot(run_dir.file(choice_plot), t.rows[i].name, *choices);
+      else
+        choice_plot.clear();
+      markdown += pattern_choice_markdown(t.rows[i].name, *choices, choice_plot);
+      results["pattern_choices"].push_back(
+          {{"model", t.rows[i].name}, {"patterns_used", choices->usage.size()}, {"plot", choice_plot}});
+    }
   }
   write_file_atomic(run_dir.file("report.md"), markdown);
   write_file_atomic(run_dir.file("report.csv"), report_csv(tables));

@@ -322,17 +322,19 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   record("prune", pruned);
 
   // export: the CG-optimized and the pruned network, verified in the other runtimes
+  const PruneRoles prune_roles =
+      prune_roles_from_json(pruned.summary.at("roles"), (stages.dir("prune") / "results.json").string());
   const Resolution lr = data.info().resolutions.front();
   std::vector<ExportCommandOptions> exports;
   YAML::Node export_config(YAML::NodeType::Sequence);
   // The CG-optimized and pruned networks go out in every format; the others as ONNX only, for
-  // the report's ONNX Runtime latency column.
-  const fs::path mmp_file = stages.dir("prune") / "mmp.cgsr";
-  for (const auto& [model, stem] : {std::pair{backbone_file, std::string("backbone")},
-                                    std::pair{enhanced_file, std::string("cg_enhanced")},
-                                    std::pair{searched_file, std::string("cg_optimized")},
-                                    std::pair{mmp_file, std::string("mmp")},
-                                    std::pair{pruned_file, std::string("pruned")}}) {
+  // the report's ONNX Runtime latency column. Each file is named after its role.
+  std::vector<std::pair<fs::path, std::string>> to_export = {
+      {backbone_file, "backbone"}, {enhanced_file, "cg_enhanced"}, {searched_file, "cg_optimized"}};
+  for (const auto& b : prune_roles.baselines) to_export.emplace_back(b.file, b.file.stem().string());
+  to_export.emplace_back(pruned_file, "pruned");
+  std::map<std::string, fs::path> onnx_of_file;  // model file -> its exported ONNX file
+  for (const auto& [model, stem] : to_export) {
     const bool deployed = stem == "cg_optimized" || stem == "pruned";
     for (const auto& format : options.export_formats) {
       if (!deployed && format != ExportFormat::Onnx) continue;
@@ -344,6 +346,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
       e.input = lr.name();
       e.verify = true;
       e.out = (stages.dir("export") / (stem + (format == ExportFormat::Onnx ? ".onnx" : ".pt"))).string();
+      if (format == ExportFormat::Onnx) onnx_of_file[model.string()] = e.out;
       exports.push_back(e);
       export_config.push_back(export_schema().emit(e));
     }
@@ -378,21 +381,20 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   // report: one table and plot of every model. The stages timed their models minutes or hours
   // apart, under whatever else the machine was doing then; the report times them again side by
   // side, in interleaved rounds over the test frames in turn, so that their latencies compare.
-  const std::string searched_name = pruned.summary.at("name").get<std::string>();
-  const std::map<std::string, fs::path> model_files = {
-      {trained.summary.at("name").get<std::string>(), backbone_file},
-      {control.name, control_file},
-      {enhance.summary.at("name").get<std::string>(), enhanced_file},
-      {searched_name, searched_file},
-      {searched_name + " MMP", stages.dir("prune") / "mmp.cgsr"},
-      {searched_name + " hybrid", pruned_file}};
-  // Each row's exported ONNX file (the static network for the hybrid model's static row).
-  const std::map<std::string, fs::path> onnx_files = {
-      {trained.summary.at("name").get<std::string>(), stages.dir("export") / "backbone.onnx"},
-      {enhance.summary.at("name").get<std::string>(), stages.dir("export") / "cg_enhanced.onnx"},
-      {searched_name, stages.dir("export") / "cg_optimized.onnx"},
-      {searched_name + " MMP", stages.dir("export") / "mmp.onnx"},
-      {searched_name + " static", stages.dir("export") / "pruned.onnx"}};
+  // Every row's model file by its display name (the static network is read from the hybrid
+  // model's file as a plain model) and its exported ONNX file.
+  std::map<std::string, fs::path> model_files = {{trained.summary.at("name").get<std::string>(), backbone_file},
+                                                 {control.name, control_file},
+                                                 {enhance.summary.at("name").get<std::string>(), enhanced_file},
+                                                 {prune_roles.input.name, searched_file},
+                                                 {prune_roles.hybrid.name, pruned_file},
+                                                 {prune_roles.static_network.name, pruned_file}};
+  for (const auto& b : prune_roles.baselines) model_files[b.name] = b.file;
+  std::map<std::string, fs::path> onnx_files;
+  for (const auto& [name, file] : model_files) {
+    const auto onnx = onnx_of_file.find(file.string());
+    if (onnx != onnx_of_file.end() && name != prune_roles.hybrid.name) onnx_files[name] = onnx->second;
+  }
   const std::vector<std::string> runs = {(stages.dir("eval") / "results.json").string(),
                                          (stages.dir("prune") / "results.json").string()};
   const auto reported = stages.run(
@@ -407,7 +409,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
               data.frames(Split::Test).empty() ? std::vector<int>{0} : data.frames(Split::Test);
           for (const auto& e : evaluations) {
             const auto file = model_files.find(e.name);
-            if (e.name == searched_name + " static")  // the static network inside the hybrid model file
+            if (e.name == prune_roles.static_network.name)
               upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(pruned_file).network));
             else
               upscalers.push_back(make_upscaler(file == model_files.end() ? e.name : file->second.string(), e.name,
@@ -437,12 +439,12 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
   roles.control = find_result(evaluations, control.name);
   roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
-  roles.cg_optimized = find_result(evaluations, searched_name);
-  roles.pruned = find_result(evaluations, searched_name + " hybrid");
-  roles.pruned_static = find_result(evaluations, searched_name + " static");
-  roles.magnitude = find_result(evaluations, searched_name + " MMP");
+  roles.cg_optimized = find_result(evaluations, prune_roles.input.name);
+  roles.pruned = find_result(evaluations, prune_roles.hybrid.name);
+  roles.pruned_static = find_result(evaluations, prune_roles.static_network.name);
+  if (const auto* mmp = prune_roles.baseline("magnitude")) roles.magnitude = find_result(evaluations, mmp->name);
   if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
-    throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + searched_name + ")",
+    throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + prune_roles.input.name + ")",
                 ErrorKind::Internal);
   const Verdict verdict = judge_pipeline(roles, options.verdict);
   write_file_atomic(root / "verdict.txt", verdict.text());

@@ -12,7 +12,7 @@
 #include "export/exporter.h"
 #include "export/verification.h"
 #include "models/inherit.h"
-#include "pruning/magnitude_pruning.h"
+#include "pruning/baseline_pruning.h"
 #include "search/search_space.h"
 #include "tests/export/export_cases.h"
 #include "tests/support/cli_runner.h"

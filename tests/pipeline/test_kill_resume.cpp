@@ -272,7 +272,7 @@ TEST(KillResume, PruneResumesItsFineTuning) {
   // configs/prune/quick.yaml, smaller still: fine-tuning of 60 steps, a checkpoint every 5.
   const std::vector<std::string> prune = {
       "prune", "--config", std::string(CGSR_SOURCE_DIR) + "/configs/prune/quick.yaml", "--model", model.string(),
-      "--data", data.string(), "--set", "warmup_steps=5", "--set", "finetune.schedule.steps=60", "--set",
+      "--data", data.string(), "--set", "selector.steps=5", "--set", "finetune.schedule.steps=60", "--set",
       "finetune.schedule.checkpoint_every=5", "--set", "finetune.schedule.batch_size=2", "--set",
       "finetune.schedule.patch_size=16", "--set", "finetune.schedule.layout=nhwc", "--set", "eval.latency_runs=0"};
   const auto reference = dir / "reference", out = dir / "run";
@@ -281,7 +281,7 @@ TEST(KillResume, PruneResumesItsFineTuning) {
 
   ASSERT_NO_FATAL_FAILURE(
       kill_when(with_run_flags(prune, out), dir / "killed", [&] { return fs::exists(out / "finetune_hybrid.pt"); }));
-  expect_killed_run_dir(out, {"pruned.cgsr", "mmp.cgsr"}, "] fine-tuning with dynamic patterns");
+  expect_killed_run_dir(out, {"pruned.cgsr", "baseline0_magnitude.cgsr"}, "] fine-tuning 3 nested patterns");
 
   r = run_cgsr_args(with_resume(with_run_flags(prune, out)), dir / "resumed");
   ASSERT_EQ(r.exit_code, 0) << r.err;

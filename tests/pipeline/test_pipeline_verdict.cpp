@@ -112,3 +112,54 @@ TEST(PipelineVerdict, MissingMeasurementsFail) {
   EXPECT_FALSE(find(v, "pruning cuts params and MACs")->passed);
   EXPECT_NE(v.text().find("FAILED"), std::string::npos);
 }
+
+namespace {
+// A hybrid that chose `patterns[i]` on frame i, with mean and p95 latency per frame.
+EvalResult hybrid(double psnr, double mean_ms, const std::vector<int>& patterns) {
+  EvalResult r = result("H", psnr, 60000, 3000000, mean_ms);
+  r.latency->mean_ms = mean_ms;
+  r.latency->p95_ms = mean_ms * 1.5;
+  for (size_t i = 0; i < patterns.size(); ++i) {
+    FrameScore f;
+    f.frame = static_cast<int>(i);
+    f.details = {{"pattern", patterns[i]}, {"channel_fraction", 1.0 - 0.2 * patterns[i]}};
+    r.frames.push_back(f);
+  }
+  return r;
+}
+}  // namespace
+
+TEST(PipelineVerdict, TheDynamicPartMustPayAgainstItsStaticNetworkAndMagnitudePruning) {
+  Story s;
+  EvalResult fixed = result("P static", 26.02, 60000, 4000000, 30.0);
+  fixed.latency->mean_ms = 30.0;
+  EvalResult mmp = result("P MMP", 25.9, 45000, 3000000, 24.0);
+  const auto judge = [&](const EvalResult& h, const VerdictOptions& o = VerdictOptions{}) {
+    PipelineResults r = s.roles();
+    r.pruned = &h;
+    r.pruned_static = &fixed;
+    r.magnitude = &mmp;
+    return judge_pipeline(r, o);
+  };
+  // 22 ms against 30 ms (0.73x), 0.02 dB below the static network, +0.1 dB over MMP, 3 patterns.
+  const EvalResult good = hybrid(26.0, 22.0, {0, 1, 2, 2, 1});
+  const Verdict v = judge(good);
+  EXPECT_TRUE(v.passed()) << v.text();
+  EXPECT_EQ(v.checks.size(), 15u + 4u);
+  EXPECT_NE(find(v, "H uses at least 3 patterns on the test frames")->detail.find("pattern 2: 2 frames (40%)"),
+            std::string::npos);
+
+  EXPECT_FALSE(find(judge(hybrid(26.0, 25.0, {0, 1, 2})), "H runs at most 0.8x its static network's mean latency")
+                   ->passed);
+  EXPECT_FALSE(find(judge(hybrid(25.95, 22.0, {0, 1, 2})), "H loses at most 0.05 dB against its static network")->passed);
+  EXPECT_FALSE(find(judge(hybrid(25.93, 22.0, {0, 1, 2})), "H gains at least 0.05 dB over P MMP")->passed);
+  EXPECT_FALSE(find(judge(hybrid(26.0, 22.0, {0, 2, 2})), "H uses at least 3 patterns on the test frames")->passed);
+  VerdictOptions two;
+  two.min_patterns_used = 2;
+  EXPECT_TRUE(find(judge(hybrid(26.0, 22.0, {0, 2, 2}), two), "H uses at least 2 patterns on the test frames")->passed);
+
+  // Without latency the claim fails rather than passing silently.
+  EvalResult untimed = good;
+  untimed.latency.reset();
+  EXPECT_FALSE(find(judge(untimed), "H runs at most 0.8x its static network's mean latency")->passed);
+}

@@ -35,9 +35,9 @@ search:
   final: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 prune:
   pool_frames: 2
-  pool: {keep_rate: 0.5, size: 2}
+  pool: {keep_rates: [1.0, 0.5]}
   sampler: {grid: 4, width: 2}
-  warmup_steps: 2
+  selector: {steps: 2, latency_runs: 1}
   finetune:
     epochs: 0
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
@@ -132,9 +132,9 @@ TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   EXPECT_NE(typo.err.find("train.schedule.stepz: unknown key 'stepz' (did you mean 'steps'?)"), std::string::npos)
       << typo.err;
   // A mistake in the last stage's section stops the run before the first stage renders anything.
-  const CliResult late = run_cgsr(base + " --set prune.pool.keep_rate=7");
+  const CliResult late = run_cgsr(base + " --set prune.pool.keep_rates=[7]");
   EXPECT_EQ(late.exit_code, 2);
-  EXPECT_NE(late.err.find("prune.pool.keep_rate: must be in"), std::string::npos) << late.err;
+  EXPECT_NE(late.err.find("prune.pool.keep_rates: must be strictly decreasing"), std::string::npos) << late.err;
   EXPECT_FALSE(fs::exists(dir / "run" / "data" / "manifest.yaml"));
 
   const CliResult filled = run_cgsr(base + " --set search.parent=x.cgsr");

@@ -1,0 +1,47 @@
+#include "pruning/importance.h"
+
+#include <torch/torch.h>
+
+#include "core/error.h"
+#include "pruning/activation_importance.h"
+
+namespace cgsr {
+
+FrameImportance magnitude_importance(const SRNetworkImpl& net, const std::vector<PrunableUnit>& units) {
+  torch::NoGradGuard no_grad;
+  const auto all = channel_importance(net.describe(false));
+  FrameImportance out;
+  for (const auto& u : units)
+    for (const auto& g : u.groups) {
+      const auto it = all.find(g);
+      CGSR_CHECK(it != all.end(), "magnitude importance: no weights produce layer group " + g);
+      out[g] = it->second.detach().to(torch::kFloat).contiguous();
+    }
+  return out;
+}
+
+const Registry<ImportanceMethod>& importance_methods() {
+  static const Registry<ImportanceMethod> registry = [] {
+    Registry<ImportanceMethod> r("importance method");
+    r.add(
+        "taylor",
+        [](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
+          return frame_importance(net, b, u, ActivationScore::Taylor);
+        },
+        "|activation x gradient of the reconstruction loss| per channel on the frame");
+    r.add(
+        "activation",
+        [](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
+          return frame_importance(net, b, u, ActivationScore::MeanAbsolute);
+        },
+        "mean |activation| per channel on the frame");
+    r.add(
+        "magnitude",
+        [](SRNetworkImpl& net, const Batch&, const std::vector<PrunableUnit>& u) { return magnitude_importance(net, u); },
+        "L1 norm of the weights producing the channel (the same on every frame)");
+    return r;
+  }();
+  return registry;
+}
+
+}  // namespace cgsr
