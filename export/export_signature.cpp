@@ -86,19 +86,24 @@ NamedTensors random_inputs(const ExportSignature& signature, int64_t width, int6
       out.emplace_back(in.name, torch::rand({batch, in.channels, h, w}, generator));
       continue;
     }
-    // Each rendering channel in its own range, so the test data looks like the real thing.
-    std::vector<torch::Tensor> parts;
-    for (const auto& name : in.channel_names) {
-      const int64_t c = channel_width(channel_from_name(name));
-      auto t = torch::rand({batch, c, h, w}, generator);
-      if (name == "normal") t = t * 2 - 1;
-      if (name == "motion") t = (t - 0.5) * 8;
-      if (name == "edge") t = (t > 0.8).to(torch::kFloat);
-      parts.push_back(t);
-    }
-    out.emplace_back(in.name, torch::cat(parts, 1));
+    out.emplace_back(in.name, random_render_info(in.channel_names, batch, h, w, generator));
   }
   return out;
+}
+
+torch::Tensor random_render_info(const std::vector<std::string>& channel_names, int64_t batch, int64_t height,
+                                 int64_t width, at::Generator& generator) {
+  // Each rendering channel in its own range, so the test data looks like the real thing.
+  std::vector<torch::Tensor> parts;
+  for (const auto& name : channel_names) {
+    const int64_t c = channel_width(channel_from_name(name));
+    auto t = torch::rand({batch, c, height, width}, generator);
+    if (name == "normal") t = t * 2 - 1;
+    if (name == "motion") t = (t - 0.5) * 8;
+    if (name == "edge") t = (t > 0.8).to(torch::kFloat);
+    parts.push_back(t);
+  }
+  return torch::cat(parts, 1);
 }
 
 std::pair<int64_t, int64_t> check_inputs(const ExportSignature& signature, const NamedTensors& inputs) {

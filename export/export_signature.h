@@ -5,6 +5,7 @@
 // channels in render_channels.h order and depth in the spec's rit.depth_encoding; output `sr`
 // [N, 3, s*H, s*W]. Read off the inference graph (models/graph.h), never off modules.
 
+#include <ATen/core/Generator.h>
 #include <torch/types.h>
 
 #include <cstdint>
@@ -52,6 +53,10 @@ using NamedTensors = std::vector<std::pair<std::string, torch::Tensor>>;
 // [0,1] (normals in [-1,1]); drawn from `generator_seed` so runs are reproducible.
 NamedTensors random_inputs(const ExportSignature& signature, int64_t width, int64_t height, uint64_t seed,
                            int64_t batch = 1);
+// One random rendering-information tensor [batch, C, height, width] of `channel_names` (render_channels.h
+// order), each channel in its range as above (motion: +-4 pixels), drawn from `generator`.
+torch::Tensor random_render_info(const std::vector<std::string>& channel_names, int64_t batch, int64_t height,
+                                 int64_t width, at::Generator& generator);
 
 // Checks that `inputs` are exactly the signature's inputs with the right shapes for one LR size;
 // returns that size (width, height). Throws cgsr::Error naming the offending input.

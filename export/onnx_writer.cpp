@@ -15,6 +15,7 @@
 #include "core/text.h"
 #include "export/bicubic_kernel.h"
 #include "export/export_signature.h"
+#include "export/onnx_builder.h"
 
 namespace cgsr {
 
@@ -33,31 +34,17 @@ namespace {
 class Writer {
  public:
   Writer(const graph::Graph& graph, const OnnxOptions& options)
-      : graph_(graph), options_(options), signature_(export_signature(graph)) {
+      : graph_(graph), options_(options), signature_(export_signature(graph)), b_(options.model_name, options.metadata) {
     if (!options.dynamic_size && (options.width <= 0 || options.height <= 0))
       throw Error("onnx export", "a fixed-size export needs a positive input size, got " +
                                      std::to_string(options.width) + "x" + std::to_string(options.height));
-    model_.set_ir_version(onnx::IR_VERSION);
-    model_.set_producer_name("cgsr");
-    model_.set_producer_version(CGSR_VERSION);
-    model_.set_domain("cgsr");
-    auto* opset = model_.add_opset_import();
-    opset->set_domain("");
-    opset->set_version(kOnnxOpset);
-    for (const auto& [key, value] : options.metadata) {
-      auto* prop = model_.add_metadata_props();
-      prop->set_key(key);
-      prop->set_value(value);
-    }
-    g_ = model_.mutable_graph();
-    g_->set_name(options.model_name);
     names_.resize(graph.values.size());
   }
 
-  onnx::ModelProto build() {
+  std::string build() {
     for (const auto& port : signature_.inputs) {
       names_[port.value] = claim(port.name);
-      declare(g_->add_input(), port);
+      declare(port, /*output=*/false);
     }
     const int output_value = signature_.output.value;
     for (const auto& op : graph_.ops) {
@@ -68,110 +55,52 @@ class Writer {
     }
     if (names_[output_value] != kExportOutput)  // the output is a graph input: nothing computes it
       node("Identity", std::string(kExportOutput) + ".identity", {names_[output_value]}, {claim(kExportOutput)});
-    declare(g_->add_output(), signature_.output);
-    return std::move(model_);
+    declare(signature_.output, /*output=*/true);
+    return b_.serialize("onnx export");
   }
 
  private:
   static std::string op_context(const std::string& name) { return "onnx export: op '" + name + "'"; }
 
-  std::string claim(const std::string& name) {
-    CGSR_CHECK(used_.insert(name).second, "onnx export: tensor name '" + name + "' used twice");
-    return name;
-  }
-
   // Spatial size of a value at the fixed export size.
   int64_t height_of(int value) const { return options_.height * graph_.values.at(value).factor; }
   int64_t width_of(int value) const { return options_.width * graph_.values.at(value).factor; }
 
-  void declare(onnx::ValueInfoProto* info, const ExportPort& port) {
-    info->set_name(port.name);
-    auto* type = info->mutable_type()->mutable_tensor_type();
-    type->set_elem_type(onnx::TensorProto::FLOAT);
-    auto* shape = type->mutable_shape();
+  void declare(const ExportPort& port, bool output) {
     const std::string suffix = port.factor == 1 ? "" : (port.name == kExportOutput ? "_sr" : "_info");
-    const auto dim = [&](int64_t fixed, const std::string& symbol) {
-      auto* d = shape->add_dim();
-      if (options_.dynamic_size && !symbol.empty())
-        d->set_dim_param(symbol);
-      else
-        d->set_dim_value(fixed);
-    };
-    dim(1, "batch");
-    dim(port.channels, "");
-    dim(options_.height * port.factor, "height" + suffix);
-    dim(options_.width * port.factor, "width" + suffix);
+    const std::vector<int64_t> dims = {1, port.channels, options_.height * port.factor, options_.width * port.factor};
+    std::vector<std::string> symbols;
+    if (options_.dynamic_size) symbols = {"batch", "", "height" + suffix, "width" + suffix};
     std::string doc = port.name == kExportOutput ? "super-resolved RGB, x" + std::to_string(port.factor)
                       : port.name == kExportColorInput ? "low-resolution RGB in [0,1]"
                                                        : "rendering information (" + join(port.channel_names) + ")" +
                                                              (port.factor > 1 ? " at " + std::to_string(port.factor) +
                                                                                     "x the colour size"
                                                                               : " at the colour size");
-    info->set_doc_string(doc);
+    if (output)
+      b_.declare_output(port.name, onnx::TensorProto::FLOAT, dims, doc, symbols);
+    else
+      b_.declare_input(port.name, onnx::TensorProto::FLOAT, dims, doc, symbols);
   }
 
+  // The builder's helpers under the names the emitters below use.
+  std::string claim(const std::string& name) { return b_.claim(name); }
   onnx::NodeProto* node(const std::string& type, const std::string& name, const std::vector<std::string>& inputs,
                         const std::vector<std::string>& outputs) {
-    auto* n = g_->add_node();
-    n->set_op_type(type);
-    n->set_name(name);
-    for (const auto& i : inputs) n->add_input(i);
-    for (const auto& o : outputs) n->add_output(o);
-    return n;
+    return b_.node(type, name, inputs, outputs);
   }
-
-  static void attr(onnx::NodeProto* n, const std::string& name, int64_t v) {
-    auto* a = n->add_attribute();
-    a->set_name(name);
-    a->set_type(onnx::AttributeProto::INT);
-    a->set_i(v);
+  template <typename T>
+  static void attr(onnx::NodeProto* n, const std::string& name, const T& v) {
+    OnnxBuilder::attr(n, name, v);
   }
-  static void attr(onnx::NodeProto* n, const std::string& name, double v) {
-    auto* a = n->add_attribute();
-    a->set_name(name);
-    a->set_type(onnx::AttributeProto::FLOAT);
-    a->set_f(static_cast<float>(v));
-  }
-  static void attr(onnx::NodeProto* n, const std::string& name, const std::string& v) {
-    auto* a = n->add_attribute();
-    a->set_name(name);
-    a->set_type(onnx::AttributeProto::STRING);
-    a->set_s(v);
-  }
-  static void attr(onnx::NodeProto* n, const std::string& name, const std::vector<int64_t>& v) {
-    auto* a = n->add_attribute();
-    a->set_name(name);
-    a->set_type(onnx::AttributeProto::INTS);
-    for (auto x : v) a->add_ints(x);
-  }
-
   std::string initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape) {
-    const auto t = value.detach().to(torch::kCPU, torch::kFloat).contiguous();
-    int64_t count = 1;
-    for (auto d : shape) count *= d;
-    CGSR_CHECK(t.numel() == count, "onnx export: initializer '" + name + "' has " + std::to_string(t.numel()) +
-                                       " values for shape of " + std::to_string(count));
-    if (!torch::isfinite(t).all().item<bool>())
-      throw Error("onnx export: tensor '" + name + "'", "contains NaN or infinite values");
-    auto* init = g_->add_initializer();
-    init->set_name(claim(name));
-    init->set_data_type(onnx::TensorProto::FLOAT);
-    for (auto d : shape) init->add_dims(d);
-    init->set_raw_data(t.data_ptr<float>(), static_cast<size_t>(t.numel()) * sizeof(float));
-    return name;
+    return b_.initializer(name, value, shape);
   }
-
   std::string int64_initializer(const std::string& name, const std::vector<int64_t>& values) {
-    auto* init = g_->add_initializer();
-    init->set_name(claim(name));
-    init->set_data_type(onnx::TensorProto::INT64);
-    init->add_dims(static_cast<int64_t>(values.size()));
-    for (auto v : values) init->add_int64_data(v);
-    return name;
+    return b_.int64_initializer(name, values);
   }
-
   std::string float_initializer(const std::string& name, const std::vector<float>& values) {
-    return initializer(name, torch::tensor(values), {static_cast<int64_t>(values.size())});
+    return b_.float_initializer(name, values);
   }
 
   void emit(const graph::Op& op, const std::string& out) {
@@ -290,10 +219,8 @@ class Writer {
   const graph::Graph& graph_;
   const OnnxOptions& options_;
   ExportSignature signature_;
-  onnx::ModelProto model_;
-  onnx::GraphProto* g_ = nullptr;
+  OnnxBuilder b_;
   std::vector<std::string> names_;
-  std::set<std::string> used_;
 };
 
 onnx::ModelProto parse_model(const std::string& bytes, const std::string& context) {
@@ -333,11 +260,7 @@ OnnxTensorInfo tensor_info(const onnx::ValueInfoProto& v) {
 }  // namespace
 
 std::string onnx_model_bytes(const graph::Graph& graph, const OnnxOptions& options) {
-  const onnx::ModelProto model = Writer(graph, options).build();
-  std::string bytes;
-  CGSR_CHECK(model.SerializeToString(&bytes), "onnx export: serialization failed");
-  check_model(model, "onnx export");
-  return bytes;
+  return Writer(graph, options).build();
 }
 
 void write_onnx(const std::filesystem::path& path, const graph::Graph& graph, const OnnxOptions& options) {

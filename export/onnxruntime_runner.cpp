@@ -98,9 +98,15 @@ std::vector<OrtModelResult> OnnxRuntimeRunner::run(const std::vector<OrtModelJob
       for (const auto& run : entry.at("runs")) {
         OrtRunResult rr;
         rr.times_ms = run.at("times_ms").get<std::vector<double>>();
-        for (const auto& o : run.at("outputs"))
+        for (const auto& o : run.at("outputs")) {
+          const std::string type = o.value("type", "float32"), file = o.at("file").get<std::string>();
+          const auto shape = o.at("shape").get<std::vector<int64_t>>();
+          if (type != "float32" && type != "int64")
+            throw Error(jobs[m].model.string(), "ONNX Runtime output '" + o.at("name").get<std::string>() +
+                                                    "' is " + type + "; the runner reads float32 and int64 only");
           rr.outputs.emplace_back(o.at("name").get<std::string>(),
-                                  read_raw_float32(o.at("file").get<std::string>(), o.at("shape").get<std::vector<int64_t>>()));
+                                  type == "int64" ? read_raw_int64(file, shape) : read_raw_float32(file, shape));
+        }
         r.runs.push_back(std::move(rr));
       }
     }

@@ -24,7 +24,7 @@ struct OrtRun {
 };
 
 struct OrtRunResult {
-  NamedTensors outputs;
+  NamedTensors outputs;  // float32, or int64 (kLong) where the model outputs int64
   std::vector<double> times_ms;
 };
 

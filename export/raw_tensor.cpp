@@ -18,15 +18,26 @@ void write_raw_float32(const std::filesystem::path& path, const torch::Tensor& t
                                       static_cast<size_t>(t.numel()) * sizeof(float)));
 }
 
-torch::Tensor read_raw_float32(const std::filesystem::path& path, const std::vector<int64_t>& shape) {
+namespace {
+torch::Tensor read_raw(const std::filesystem::path& path, const std::vector<int64_t>& shape, torch::ScalarType type,
+                       const char* type_name) {
   const std::string bytes = read_file(path);
-  auto t = torch::empty(shape, torch::kFloat);
-  const size_t want = static_cast<size_t>(t.numel()) * sizeof(float);
+  auto t = torch::empty(shape, type);
+  const size_t want = static_cast<size_t>(t.numel()) * t.element_size();
   if (bytes.size() != want)
-    throw Error(path.string(), "holds " + std::to_string(bytes.size()) + " bytes, a float32 " + shape_string(t) +
-                                   " tensor needs " + std::to_string(want));
-  std::memcpy(t.data_ptr<float>(), bytes.data(), want);
+    throw Error(path.string(), "holds " + std::to_string(bytes.size()) + " bytes, a " + type_name + " " +
+                                   shape_string(t) + " tensor needs " + std::to_string(want));
+  std::memcpy(t.data_ptr(), bytes.data(), want);
   return t;
+}
+}  // namespace
+
+torch::Tensor read_raw_float32(const std::filesystem::path& path, const std::vector<int64_t>& shape) {
+  return read_raw(path, shape, torch::kFloat, "float32");
+}
+
+torch::Tensor read_raw_int64(const std::filesystem::path& path, const std::vector<int64_t>& shape) {
+  return read_raw(path, shape, torch::kLong, "int64");
 }
 
 }  // namespace cgsr

@@ -57,6 +57,9 @@ class DynamicSamplersImpl : public torch::nn::Module {
   int64_t parameter_count() const;
   // Multiply-accumulates of one frame's scoring.
   int64_t macs() const;
+  // [1, U, K] added to the head's scores: 0 for real patterns, -1e9 for padding (exporters
+  // write it into the file).
+  const torch::Tensor& invalid_mask() const { return invalid_; }
 
   torch::nn::Conv2d conv1{nullptr}, conv2{nullptr}, head{nullptr};
 

@@ -4,14 +4,19 @@
 
 #include <cstdio>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/runtime.h"
 #include "core/text.h"
 #include "export/exporter.h"
+#include "export/hybrid_export.h"
+#include "export/hybrid_verification.h"
 #include "export/onnx_writer.h"
 #include "export/verification.h"
 #include "models/arch_spec.h"
+#include "models/complexity.h"
 #include "models/model_source.h"
+#include "pruning/hybrid_model.h"
 
 namespace cgsr::cli {
 
@@ -28,7 +33,7 @@ config::Schema<ExportCommandOptions> export_schema() {
       .one_of({"conv", "native"});
   s.field("verify", &ExportCommandOptions::verify, "verify the file in other runtimes against our forward pass");
   s.field("tolerance", &ExportCommandOptions::tolerance, "max abs error allowed by verify").range(0, 1);
-  s.field("out", &ExportCommandOptions::out, "the file to write").required();
+  s.field("out", &ExportCommandOptions::out, "the file to write (a directory for a hybrid-pruned model)").required();
   s.validate([](const ExportCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     parse_size(o.input, "input");
     if (o.dynamic_size && o.format != ExportFormat::Onnx)
@@ -50,15 +55,94 @@ void setup_export(CLI::App& app) {
         flag_to_key(sub, flags, "--cubic-resize", "cubic_resize", "ONNX bicubic resize: conv or native");
         switch_to_key(sub, flags, "--verify", "verify", "verify in other runtimes against our forward pass");
         flag_to_key(sub, flags, "--tolerance", "tolerance", "max abs error allowed by --verify");
-        flag_to_key(sub, flags, "--out", "out", "the file to write");
+        flag_to_key(sub, flags, "--out", "out", "the file to write (a directory for a hybrid-pruned model)");
       },
       [](const ExportCommandOptions& options, const YAML::Node&, RunDir*) { return run_export(options); },
       /*always_run_dir=*/false);
 }
 
+namespace {
+
+// Prints the verification table and turns failures into errors naming `what`.
+void report_verification(const VerifyReport& report, double tolerance, const std::string& what) {
+  std::printf("\n%s", report.table().c_str());
+  std::printf("verification: %d passed, %d failed, %d skipped (tolerance %g)\n", report.passed(), report.failed(),
+              report.skipped(), tolerance);
+  if (report.failed() > 0)
+    throw Error(what, "verification failed: " + std::to_string(report.failed()) + " of " +
+                          std::to_string(report.checks.size()) +
+                          " checks did not run or did not match our forward pass",
+                ErrorKind::Internal);
+  if (!report.ok()) throw Error(what, "verification could not run: every runtime was skipped (see above)");
+}
+
+// A hybrid-pruned model: a directory of pattern files, the selector and the manifest.
+nlohmann::ordered_json run_hybrid_export(const ExportCommandOptions& options, const ExportOptions& o) {
+  const HybridModel model = load_hybrid_model(options.model);
+  const HybridExport exported = export_hybrid(model, options.out, o);
+  nlohmann::ordered_json results;
+  results["model"] = exported.manifest.at("model");
+  results["hybrid"] = true;
+  results["dir"] = exported.dir.string();
+  results["manifest"] = exported.manifest_file.string();
+  results["format"] = enum_name(o.format);
+  std::printf("%s: hybrid-pruned %s, %d patterns (%s) + selector\n", exported.dir.string().c_str(),
+              exported.manifest.at("model").get<std::string>().c_str(), static_cast<int>(exported.patterns.size()),
+              enum_name(o.format));
+  std::printf("  %s\n", signature_string(exported.patterns.front().signature, o.width, o.height).c_str());
+  std::printf("  %-16s %8s %10s %10s %10s\n", "file", "channels", "MACs", "KiB", "latency");
+  auto files = nlohmann::ordered_json::array();
+  const auto& entries = exported.manifest.at("patterns");
+  for (size_t k = 0; k < exported.patterns.size(); ++k) {
+    const auto& e = entries.at(k);
+    char latency[32] = "-";
+    if (!e.at("latency_ms").is_null()) std::snprintf(latency, sizeof latency, "%.2f ms", e.at("latency_ms").get<double>());
+    std::printf("  %-16s %7.0f%% %10s %10.1f %10s\n", e.at("file").get<std::string>().c_str(),
+                100.0 * e.at("channel_fraction").get<double>(), format_count(e.at("macs").get<double>()).c_str(),
+                static_cast<double>(exported.patterns[k].bytes) / 1024.0, latency);
+    files.push_back({{"file", exported.patterns[k].file.string()}, {"bytes", exported.patterns[k].bytes}});
+  }
+  const auto selector_bytes = std::filesystem::file_size(exported.selector_file);
+  std::printf("  %-16s %8s %10s %10.1f\n", kSelectorFile, "-",
+              format_count(exported.manifest.at("selector").at("macs").get<double>()).c_str(),
+              static_cast<double>(selector_bytes) / 1024.0);
+  files.push_back({{"file", exported.selector_file.string()}, {"bytes", selector_bytes}});
+  results["files"] = files;
+  const OnnxModelInfo selector = inspect_onnx_file(exported.selector_file);
+  std::vector<std::string> ops;
+  for (const auto& [type, count] : selector.op_counts) ops.push_back(type + " " + std::to_string(count));
+  std::printf("  selector: opset %lld, ONNX checker ok; %s\n", static_cast<long long>(selector.opset), join(ops).c_str());
+  std::printf("  manifest: %s\n", exported.manifest_file.string().c_str());
+  // results.json sits beside the files (also when verification fails, so the failure is on record).
+  const auto results_file = exported.dir / "results.json";
+  if (!options.verify) {
+    write_file_atomic(results_file, results.dump(2) + "\n");
+    return results;
+  }
+  VerifyOptions v;
+  v.tolerance = options.tolerance;
+  const uint64_t seed = make_rng("export-verify")();
+  const VerifyReport report = verify_hybrid_export(model, exported, v, seed);
+  results["verification"] = report.to_json();
+  write_file_atomic(results_file, results.dump(2) + "\n");
+  report_verification(report, options.tolerance, exported.dir.string());
+  return results;
+}
+
+}  // namespace
+
 nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   const auto [w, h] = parse_size(options.input, "--input");
   ModelSource source = resolve_model(options.model, options.scale);
+  if (source.provenance && is_hybrid_model(*source.provenance)) {
+    ExportOptions o;
+    o.format = options.format;
+    o.width = w;
+    o.height = h;
+    o.dynamic_size = options.dynamic_size;
+    o.cubic = cubic_resize_from_name(options.cubic_resize);
+    return run_hybrid_export(options, o);
+  }
   SRNetwork net = source.network;
   net->eval();
 
@@ -101,17 +185,8 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   v.tolerance = options.tolerance;
   const uint64_t seed = make_rng("export-verify")();
   const VerifyReport report = verify_exports({make_verify_case(*net, exported, sizes, seed)}, v);
-  std::printf("\n%s", report.table().c_str());
-  std::printf("verification: %d passed, %d failed, %d skipped (tolerance %g)\n", report.passed(), report.failed(),
-              report.skipped(), options.tolerance);
   results["verification"] = report.to_json();
-  if (report.failed() > 0)
-    throw Error(exported.file.string(), "verification failed: " + std::to_string(report.failed()) + " of " +
-                                            std::to_string(report.checks.size()) +
-                                            " checks did not run or did not match our forward pass",
-                ErrorKind::Internal);
-  if (!report.ok())
-    throw Error(exported.file.string(), "verification could not run: every runtime was skipped (see above)");
+  report_verification(report, options.tolerance, exported.file.string());
   return results;
 }
 

@@ -5,7 +5,9 @@
 //   cgsr export --model pan --scale 2 --format onnx --input 320x240 --out pan_x2.onnx --verify
 //   cgsr export --model runs/train/model.cgsr --format torchscript --out model.pt
 //
-// --out here names the exported file (the command writes no run directory).
+// --out here names the exported file (the command writes no run directory). A hybrid-pruned model
+// file (pruning/hybrid_model.h) exports as a directory instead: --out DIR gets one file per
+// pattern, selector.onnx, manifest.json and results.json (export/hybrid_export.h).
 
 #include <CLI/CLI.hpp>
 

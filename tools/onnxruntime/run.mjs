@@ -6,9 +6,10 @@
 //                 "inputs": [{"name": "lr_color", "shape": [1, 3, 10, 12], "file": "in.f32"}],
 //                 "output_prefix": "out", "warmup": 0, "repeats": 1}]}]}
 // RESULT.json: {"onnxruntime": "1.30.0", "models": [{"path": ..., "load_ms": ..., "error": null,
-//                 "runs": [{"outputs": [{"name": "sr", "shape": [...], "file": "out.sr.f32"}],
-//                           "times_ms": [...]}]}]}
-// Tensors are raw little-endian float32 files. An error in one model is recorded in its entry
+//                 "runs": [{"outputs": [{"name": "sr", "type": "float32", "shape": [...],
+//                                        "file": "out.sr.f32"}], "times_ms": [...]}]}]}
+// Tensors are raw little-endian files: inputs float32, outputs of their own type (float32, or
+// int64 for an index such as the hybrid selector's ArgMax). An error in one model is recorded in its entry
 // and the others still run; the exit code is non-zero only when the job itself is unusable.
 import { readFileSync, writeFileSync } from 'node:fs';
 import { performance } from 'node:perf_hooks';
@@ -56,7 +57,7 @@ async function runModel(model, threads) {
         const file = `${run.output_prefix}.${name}.f32`;
         const data = tensor.data;
         writeFileSync(file, Buffer.from(data.buffer, data.byteOffset, data.byteLength));
-        outputs.push({ name, shape: tensor.dims.map(Number), file });
+        outputs.push({ name, type: tensor.type, shape: tensor.dims.map(Number), file });
       }
       entry.runs.push({ outputs, times_ms: times });
     }
