@@ -36,6 +36,8 @@ config::Schema<FinetuneOptions> finetune_schema() {
   s.field("sampled_patterns", &FinetuneOptions::sampled_patterns,
           "patterns between the widest and the narrowest trained per step (sandwich rule)")
       .range(0, 64);
+  s.field("distill", &FinetuneOptions::distill,
+          "narrower patterns learn the widest pattern's output instead of the HR frame (in-place distillation)");
   return s;
 }
 
@@ -151,13 +153,15 @@ TrainHooks DynamicPruning::hooks(const FinetuneOptions& options) {
   const LossOptions loss = options.loss;
   const double lambda = options.lambda_pruned;
   const int sampled = options.sampled_patterns;
-  hooks.extra_loss = [this, loss, lambda, sampled](const Batch& batch, const TrainOutput&, int step) {
+  const bool distill = options.distill;
+  hooks.extra_loss = [this, loss, lambda, sampled, distill](const Batch& batch, const TrainOutput& widest, int step) {
     const int64_t n = batch.lr_color.size(0);
     auto total = lambda > 0 ? lambda * masks_->pruned_weight_l1(masks_->group_masks(0, n)) : torch::zeros({});
+    const auto target = distill ? widest.image.detach() : batch.hr_color;
     for (int k : sandwich(pool_.size(), sampled, step)) {
       const auto masks = masks_->group_masks(k, n);
       const auto out = masks_->forward(batch.lr_color, network_->info_input(batch), masks);
-      total = total + reconstruction_error(out, batch.hr_color, loss.image_norm);
+      total = total + reconstruction_error(out, target, loss.image_norm);
       if (lambda > 0) total = total + lambda * masks_->pruned_weight_l1(masks);
     }
     return total;

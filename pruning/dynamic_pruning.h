@@ -5,8 +5,14 @@
 //      (pattern_pool.h) works on its own, by the sandwich rule: each step trains the widest
 //      pattern (the trainer's own loss), the narrowest and `sampled_patterns` others drawn per
 //      step, each with L_p = ||HR - SR||_2 + lambda_pruned * ||W_P||_1 (Eq. 4 of the paper, W_P
-//      the weights the pattern leaves out; pattern_masks.h). The widest pattern, the static
-//      network, is itself trained.
+//      the weights the pattern leaves out; pattern_masks.h). lambda_pruned is 0 by default: with
+//      nested patterns every weight a narrow pattern leaves out is one a wider pattern uses, and
+//      the L1 term (summed over weights, hundreds of times the image loss at 1e-4) shrank them
+//      until the static network lost 0.24 dB on the quickstart (README, "Pruning"). The widest pattern, the static
+//      network, is itself trained. With `distill` the narrower patterns learn the widest's
+//      output (detached) instead of the HR frame (in-place distillation, as slimmable networks
+//      are trained): their gradients then pull the shared channels toward what the widest
+//      computes rather than away from it.
 //   2. fit_selector(): the dynamic pruning component (the sampler, dynamic_sampler.h) learns to
 //      choose a pattern per frame from the rendering information of that frame and the one
 //      before. On every training frame each pattern's PSNR loss against the widest is measured
@@ -38,8 +44,9 @@ struct FinetuneOptions {
   double epochs = 2;             // passes over the training frames' LR pixels; 0: schedule.steps
   TrainSchedule schedule;        // batch, patch size, learning rates (steps from epochs when > 0)
   LossOptions loss;              // the image term of L_p (and the RIT gate penalty)
-  double lambda_pruned = 1e-4;   // weight of ||W_P||_1
+  double lambda_pruned = 0;      // weight of ||W_P||_1 (see above)
   int sampled_patterns = 1;      // patterns between the widest and the narrowest trained per step
+  bool distill = true;           // narrower patterns learn the widest's output, not the HR frame
   FinetuneOptions();
 };
 config::Schema<FinetuneOptions> finetune_schema();

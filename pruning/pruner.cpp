@@ -9,6 +9,7 @@
 #include "pruning/hybrid_upscaler.h"
 #include "pruning/pattern_networks.h"
 #include "render_data/patch_sampler.h"
+#include "train/pattern_choice.h"
 
 namespace cgsr {
 
@@ -278,7 +279,12 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   {
     HybridUpscaler from_file(roles.hybrid.name, load_hybrid_model(roles.hybrid.file));
     evaluations.push_back(evaluate(from_file, data, options.eval));
-    results["test_selected_per_pattern"] = from_file.usage();
+    // Per pattern, the evaluated frames that chose it (the upscaler also ran frames before them,
+    // for the temporal error).
+    std::vector<int> usage(hybrid.pool.size(), 0);
+    if (const auto choices = pattern_choices(evaluations.back()))
+      for (const auto& [k, n] : choices->usage) usage.at(k) = n;
+    results["test_selected_per_pattern"] = usage;
   }
   results["evaluations"] = nlohmann::ordered_json::array();
   results["comparison"] = nlohmann::ordered_json::array();

@@ -133,25 +133,16 @@ nlohmann::ordered_json run_hybrid_export(const ExportCommandOptions& options, co
 
 nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   const auto [w, h] = parse_size(options.input, "--input");
-  ModelSource source = resolve_model(options.model, options.scale);
-  if (source.provenance && is_hybrid_model(*source.provenance)) {
-    ExportOptions o;
-    o.format = options.format;
-    o.width = w;
-    o.height = h;
-    o.dynamic_size = options.dynamic_size;
-    o.cubic = cubic_resize_from_name(options.cubic_resize);
-    return run_hybrid_export(options, o);
-  }
-  SRNetwork net = source.network;
-  net->eval();
-
   ExportOptions o;
   o.format = options.format;
   o.width = w;
   o.height = h;
   o.dynamic_size = options.dynamic_size;
   o.cubic = cubic_resize_from_name(options.cubic_resize);
+  ModelSource source = resolve_model(options.model, options.scale);
+  if (source.provenance && is_hybrid_model(*source.provenance)) return run_hybrid_export(options, o);
+  SRNetwork net = source.network;
+  net->eval();
   const ExportedModel exported = export_network(*net, options.out, o);
 
   nlohmann::ordered_json results;

@@ -21,6 +21,7 @@
 #include "core/timing.h"
 #include "core/yaml_json.h"
 #include "export/exporter.h"
+#include "export/hybrid_export.h"
 #include "export/onnx_writer.h"
 #include "export/onnxruntime_runner.h"
 #include "models/model_file.h"
@@ -328,7 +329,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   std::vector<ExportCommandOptions> exports;
   YAML::Node export_config(YAML::NodeType::Sequence);
   // The CG-optimized and pruned networks go out in every format; the others as ONNX only, for
-  // the report's ONNX Runtime latency column. Each file is named after its role.
+  // the report's ONNX Runtime latency column. Each file is named after its role; the hybrid model
+  // goes out as its deployment directory (a file per pattern, the selector, the manifest).
   std::vector<std::pair<fs::path, std::string>> to_export = {
       {backbone_file, "backbone"}, {enhanced_file, "cg_enhanced"}, {searched_file, "cg_optimized"}};
   for (const auto& b : prune_roles.baselines) to_export.emplace_back(b.file, b.file.stem().string());
@@ -345,8 +347,13 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
       e.format = format;
       e.input = lr.name();
       e.verify = true;
-      e.out = (stages.dir("export") / (stem + (format == ExportFormat::Onnx ? ".onnx" : ".pt"))).string();
-      if (format == ExportFormat::Onnx) onnx_of_file[model.string()] = e.out;
+      const bool onnx = format == ExportFormat::Onnx;
+      e.out = (stages.dir("export") / (model == pruned_file ? stem + (onnx ? "" : "_torchscript")
+                                                            : stem + (onnx ? ".onnx" : ".pt")))
+                  .string();
+      // The hybrid's pattern 0 is its static network.
+      if (onnx)
+        onnx_of_file[model.string()] = model == pruned_file ? fs::path(e.out) / pattern_file_name(0, format) : fs::path(e.out);
       exports.push_back(e);
       export_config.push_back(export_schema().emit(e));
     }

@@ -90,7 +90,8 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   for (const std::string stage : {"data", "train", "enhance", "control", "search", "prune", "export", "eval", "report"})
     EXPECT_TRUE(read_json(out / stage / "stage.json")["done"].get<bool>()) << stage;
   for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "control/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
-                                 "export/cg_optimized.onnx", "export/pruned.onnx", "export/pruned.pt",
+                                 "export/cg_optimized.onnx", "export/pruned/pattern_0.onnx", "export/pruned/selector.onnx",
+                                 "export/pruned/manifest.json", "export/pruned_torchscript/pattern_0.pt",
                                  "report/report.md", "verdict.txt", "results.json", "log.txt"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
 
