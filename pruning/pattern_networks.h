@@ -44,7 +44,7 @@ class PatternNetworks {
  private:
   PatternPool pool_;
   std::vector<graph::Graph> graphs_;
-  std::vector<std::unique_ptr<FusedGraph>> fused_;  // built on first use
+  std::vector<std::unique_ptr<FusedGraph>> fused_;  // all built at the first run
 };
 
 }  // namespace cgsr

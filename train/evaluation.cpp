@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -138,12 +139,23 @@ std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::option
 }
 }  // namespace
 
-std::vector<Batch> timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
-                                   const Upscaler& upscaler, int count) {
-  constexpr size_t kMaxFrames = 8;  // frames held in memory (a 1080p batch is tens of MB)
-  std::vector<Batch> out;
-  for (size_t i = 0; i < frames.size() && out.size() < std::min<size_t>(kMaxFrames, std::max(1, count)); ++i)
-    out.push_back(frame_batch(data, frames[i], scale, upscaler.channels(), upscaler.depth_encoding()));
+torch::Tensor TimingSequence::run(Upscaler& upscaler, size_t i) const {
+  if (!previous.empty()) upscaler.previous_frame(previous.at(i));
+  return upscaler.upscale(frames.at(i));
+}
+
+TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
+                               const Upscaler& upscaler, int count) {
+  constexpr int kMaxFrames = 16;  // frames held in memory (a 1080p batch is tens of MB)
+  const auto channels = upscaler.channels();
+  const DepthEncoding depth = upscaler.depth_encoding();
+  TimingSequence out;
+  // Spread over the frames, so that a model whose cost depends on the frame is timed on a fair
+  // share of easy and hard ones.
+  for (int f : spread_frames(frames, std::min(kMaxFrames, std::max(1, count)))) {
+    out.frames.push_back(frame_batch(data, f, scale, channels, depth));
+    if (upscaler.uses_previous_frame()) out.previous.push_back(frame_batch(data, std::max(0, f - 1), scale, channels, depth));
+  }
   return out;
 }
 
@@ -253,13 +265,13 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   if (options.latency_runs > 0) {
     // Timed on the evaluated frames in turn, as a renderer calls it: an upscaler whose work
     // depends on the frame (a hybrid-pruned model) is timed on what it chooses per frame.
-    const std::vector<Batch> sequence = timing_sequence(data, frames, result.scale, upscaler, options.latency_runs);
+    const TimingSequence sequence = timing_sequence(data, frames, result.scale, upscaler, options.latency_runs);
     constexpr int kWarmup = 2;
     Progress timing("latency " + result.name, kWarmup + options.latency_runs);
     size_t next = 0;
     result.latency = measure_latency(
         [&] {
-          upscaler.upscale(sequence[next++ % sequence.size()]);
+          sequence.run(upscaler, next++ % sequence.size());
           timing.advance();
         },
         kWarmup, options.latency_runs);

@@ -27,7 +27,7 @@ struct EvalOptions {
   int crop_border = 0;         // pixels (HR) ignored at each side
   bool y_channel = false;      // PSNR/SSIM on BT.601 luma instead of RGB
   bool temporal = true;        // needs motion vectors and the previous frame
-  int latency_runs = 10;       // timed runs (after 2 warm-up runs) over the first frames in turn; 0 = skip
+  int latency_runs = 10;       // timed runs (after 2 warm-up runs) over that many frames in turn; 0 = skip
   std::string save_frames;     // directory for SR frames as PNG; "" = do not save
 };
 config::Schema<EvalOptions> eval_schema_fields();
@@ -66,10 +66,20 @@ struct EvalResult {
   std::optional<Complexity> cost;
 };
 
-// The first frames of `frames` (at most `count`, at most 8) as the upscaler reads them: the
-// sequence latency is timed on, in turn.
-std::vector<Batch> timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
-                                   const Upscaler& upscaler, int count);
+// At most `count` (and 16) of `frames`, spread over them, as the upscaler reads them: what
+// latency is timed on, frame after frame. An upscaler that reads the previous frame (a
+// hybrid-pruned model chooses its pattern from the change) is shown each frame's predecessor
+// first, as evaluate() does, so that it is timed on the choices it was evaluated with.
+struct TimingSequence {
+  std::vector<Batch> frames;
+  std::vector<Batch> previous;  // previous[i]: the frame before frames[i]; empty when not read
+
+  size_t size() const { return frames.size(); }
+  // Upscales frame i (after showing the upscaler its predecessor).
+  torch::Tensor run(Upscaler& upscaler, size_t i) const;
+};
+TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
+                               const Upscaler& upscaler, int count);
 
 // `on_quality` is called once the quality figures are known, before the latency is measured
 // (which can take minutes at 1080p), so callers can write them out early.

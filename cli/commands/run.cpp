@@ -409,8 +409,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
         std::vector<EvalResult> evaluations = collect_evaluations(runs);
         if (eval.latency_runs > 0) {
           std::vector<std::unique_ptr<Upscaler>> upscalers;
-          std::vector<std::vector<Batch>> sequences;  // per model, test frames timed in turn
-          std::vector<Batch> frames;                   // per model, the first of them
+          std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
+          std::vector<Batch> frames;              // per model, the first of them
           std::vector<std::function<void()>> timed;
           const std::vector<int> test_frames =
               data.frames(Split::Test).empty() ? std::vector<int>{0} : data.frames(Split::Test);
@@ -423,11 +423,11 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
                                                 backbone.scale));
             sequences.push_back(
                 timing_sequence(data, test_frames, backbone.scale, *upscalers.back(), eval.latency_runs));
-            frames.push_back(sequences.back().front());
+            frames.push_back(sequences.back().frames.front());
           }
           for (size_t i = 0; i < upscalers.size(); ++i)
             timed.push_back([&, i, next = size_t{0}]() mutable {
-              upscalers[i]->upscale(sequences[i][next++ % sequences[i].size()]);
+              sequences[i].run(*upscalers[i], next++ % sequences[i].size());
             });
           spdlog::info("timing {} models side by side ({} interleaved rounds over {} test frames)", timed.size(),
                        eval.latency_runs, sequences.front().size());

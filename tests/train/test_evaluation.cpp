@@ -250,3 +250,46 @@ TEST(Evaluation, EvalCommandLoadsEdgesForUpscalersThatDoNotReadThem) {
   EXPECT_NE(r.out.find("| Edge PSNR (dB) | Rest PSNR (dB) |"), std::string::npos) << r.out;
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+// Bicubic that reads the previous frame and records what it was shown, in order.
+class RecordingUpscaler : public Upscaler {
+ public:
+  std::string name() const override { return "recording"; }
+  int scale() const override { return 2; }
+  bool uses_previous_frame() const override { return true; }
+  void previous_frame(const Batch& previous) override { seen.push_back(-previous.frames.front()); }
+  torch::Tensor upscale(const Batch& batch) override {
+    seen.push_back(batch.frames.front());
+    return bicubic_->upscale(batch);
+  }
+  std::vector<int> seen;  // upscaled frames, and the previous frames shown as negatives
+
+ private:
+  std::unique_ptr<Upscaler> bicubic_ = classic_upscalers().get("bicubic")(2);
+};
+}  // namespace
+
+// Latency is timed on what quality was measured with: an upscaler that reads the previous frame
+// is shown each timed frame's predecessor first, as evaluate() shows it.
+TEST(Evaluation, TimingShowsEachFrameItsPredecessor) {
+  const Dataset data = Dataset::open(tiny_data());
+  RecordingUpscaler recording;
+  const TimingSequence sequence = timing_sequence(data, {1, 2, 4, 5}, 2, recording, 2);
+  ASSERT_EQ(sequence.size(), 2u);  // `count` frames, spread over the frames given
+  sequence.run(recording, 1);
+  sequence.run(recording, 0);
+  EXPECT_EQ(recording.seen, (std::vector<int>{-3, 4, 0, 1}));
+
+  auto bicubic = classic_upscalers().get("bicubic")(2);
+  EXPECT_TRUE(timing_sequence(data, {2, 4}, 2, *bicubic, 5).previous.empty());
+
+  EvalOptions timed = all_frames("3:5");
+  timed.latency_runs = 3;
+  recording.seen.clear();
+  const EvalResult r = evaluate(recording, data, timed);
+  ASSERT_TRUE(r.latency.has_value());
+  // Quality, then 2 warm-up and 3 timed runs over frames 3 and 4 in turn, each after its predecessor.
+  const std::vector<int> timing(recording.seen.end() - 10, recording.seen.end());
+  EXPECT_EQ(timing, (std::vector<int>{-2, 3, -3, 4, -2, 3, -3, 4, -2, 3}));
+}
