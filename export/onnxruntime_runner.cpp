@@ -5,10 +5,10 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/runtime.h"
 #include "export/raw_tensor.h"
+#include "export/external_runner.h"
 #include "export/subprocess.h"
 
 namespace cgsr {
@@ -45,7 +45,7 @@ OnnxRuntimeRunner::OnnxRuntimeRunner(int threads) : dir_(runner_dir()), threads_
 }
 
 std::vector<OrtModelResult> OnnxRuntimeRunner::run(const std::vector<OrtModelJob>& jobs) const {
-  TempDir tmp("cgsr-ort");
+  const ExternalJob external("ONNX Runtime", "cgsr-ort");
   nlohmann::ordered_json job;
   job["threads"] = threads_;
   job["models"] = nlohmann::ordered_json::array();
@@ -57,32 +57,15 @@ std::vector<OrtModelResult> OnnxRuntimeRunner::run(const std::vector<OrtModelJob
       const OrtRun& run = jobs[m].runs[r];
       const std::string stem = "m" + std::to_string(m) + "_r" + std::to_string(r);
       nlohmann::ordered_json entry;
-      entry["inputs"] = nlohmann::ordered_json::array();
-      for (const auto& [name, t] : run.inputs) {
-        const fs::path file = tmp.path() / (stem + "." + name + ".in.f32");
-        write_raw_float32(file, t);
-        entry["inputs"].push_back({{"name", name}, {"shape", t.sizes().vec()}, {"file", file.string()}});
-      }
-      entry["output_prefix"] = (tmp.path() / (stem + ".out")).string();
+      entry["inputs"] = external.write_inputs(run.inputs, stem);
+      entry["output_prefix"] = external.file(stem + ".out").string();
       entry["warmup"] = run.warmup;
       entry["repeats"] = run.repeats;
       model["runs"].push_back(entry);
     }
     job["models"].push_back(model);
   }
-  const fs::path job_file = tmp.path() / "job.json", result_file = tmp.path() / "result.json";
-  write_file_atomic(job_file, job.dump());
-  const ProcessResult p = run_process({node_.string(), (dir_ / "run.mjs").string(), job_file.string(),
-                                       result_file.string()});
-  if (p.exit_code != 0 || !fs::exists(result_file))
-    throw Error("ONNX Runtime", "the runner failed (exit " + std::to_string(p.exit_code) + "): " +
-                                    (p.err.empty() ? p.out : p.err));
-  nlohmann::json result;
-  try {
-    result = nlohmann::json::parse(read_file(result_file));
-  } catch (const nlohmann::json::exception& e) {
-    throw Error("ONNX Runtime", std::string("unreadable runner result: ") + e.what(), ErrorKind::Internal);
-  }
+  const nlohmann::json result = external.run(job, {node_.string(), (dir_ / "run.mjs").string()});
   version_ = result.value("onnxruntime", "unknown");
   std::vector<OrtModelResult> out;
   const auto& models = result.at("models");

@@ -6,10 +6,10 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/text.h"
 #include "export/raw_tensor.h"
+#include "export/external_runner.h"
 #include "export/subprocess.h"
 #include "export/torchscript_writer.h"
 
@@ -67,7 +67,7 @@ std::string python_torch_version() { return cached_python_version(); }
 
 std::vector<PythonTorchResult> run_torchscript_python(const std::vector<PythonTorchJob>& jobs) {
   if (const std::string why = python_torch_unavailable_reason(); !why.empty()) throw Error("Python torch", why);
-  TempDir tmp("cgsr-python");
+  const ExternalJob external("Python torch", "cgsr-python");
   nlohmann::ordered_json job;
   job["models"] = nlohmann::ordered_json::array();
   for (size_t m = 0; m < jobs.size(); ++m) {
@@ -77,23 +77,13 @@ std::vector<PythonTorchResult> run_torchscript_python(const std::vector<PythonTo
     for (size_t r = 0; r < jobs[m].runs.size(); ++r) {
       const std::string stem = "m" + std::to_string(m) + "_r" + std::to_string(r);
       nlohmann::ordered_json run;
-      run["inputs"] = nlohmann::ordered_json::array();
-      for (const auto& [name, t] : jobs[m].runs[r]) {
-        const fs::path file = tmp.path() / (stem + "." + name + ".f32");
-        write_raw_float32(file, t);
-        run["inputs"].push_back({{"name", name}, {"shape", t.sizes().vec()}, {"file", file.string()}});
-      }
-      run["output"] = (tmp.path() / (stem + ".out.f32")).string();
+      run["inputs"] = external.write_inputs(jobs[m].runs[r], stem);
+      run["output"] = external.file(stem + ".out.f32").string();
       model["runs"].push_back(run);
     }
     job["models"].push_back(model);
   }
-  const fs::path job_file = tmp.path() / "job.json", result_file = tmp.path() / "result.json";
-  write_file_atomic(job_file, job.dump());
-  const ProcessResult p = run_process({python_name(), python_script().string(), job_file.string(), result_file.string()});
-  if (p.exit_code != 0 || !fs::exists(result_file))
-    throw Error("Python torch", "the runner failed (exit " + std::to_string(p.exit_code) + "): " + p.err);
-  const auto result = nlohmann::json::parse(read_file(result_file));
+  const nlohmann::json result = external.run(job, {python_name(), python_script().string()});
   std::vector<PythonTorchResult> out;
   const auto& models = result.at("models");
   CGSR_CHECK(models.size() == jobs.size(), "Python runner returned a different number of models");

@@ -1,4 +1,4 @@
-// The runtime runners: raw tensor files, subprocesses, ONNX Runtime through node, OpenCV DNN's
+// The runtime runners: raw tensor files, subprocesses, the job plumbing they share, ONNX Runtime through node, OpenCV DNN's
 // fixed-size rule, and their errors.
 
 #include <gtest/gtest.h>
@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "export/exporter.h"
+#include "export/external_runner.h"
 #include "export/onnxruntime_runner.h"
 #include "export/opencv_runner.h"
 #include "export/raw_tensor.h"
@@ -42,6 +43,37 @@ TEST(Subprocess, CapturesExitCodeAndOutputs) {
     EXPECT_TRUE(std::filesystem::exists(kept));
   }
   EXPECT_FALSE(std::filesystem::exists(kept));
+}
+
+// The runners' shared plumbing, with sh standing in for node or python3 (it is handed
+// job.json and result.json as $1 and $2).
+TEST(ExternalJob, WritesInputsRunsTheProgramAndReadsItsResult) {
+  const ExternalJob job("Test runtime", "external-job-test");
+  const auto t = torch::rand({1, 2, 3, 4});
+  nlohmann::ordered_json spec;
+  spec["inputs"] = job.write_inputs({{"x", t}}, "m0_r0");
+  const auto echoed = job.run(spec, {"sh", "-c", "cp \"$1\" \"$2\"", "sh"});
+  ASSERT_EQ(echoed["inputs"].size(), 1u);
+  EXPECT_EQ(echoed["inputs"][0]["name"], "x");
+  EXPECT_EQ(echoed["inputs"][0]["shape"], nlohmann::json({1, 2, 3, 4}));
+  EXPECT_TRUE(torch::equal(read_raw_float32(echoed["inputs"][0]["file"].get<std::string>(), {1, 2, 3, 4}), t));
+}
+
+TEST(ExternalJob, AFailedOrUnreadableRunIsAnErrorNamingTheRuntime) {
+  const ExternalJob job("Test runtime", "external-job-test");
+  const auto message = [&](const std::vector<std::string>& program) {
+    try {
+      job.run(nlohmann::ordered_json::object(), program);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message({"sh", "-c", "echo broken >&2; exit 4", "sh"}).find("Test runtime"), std::string::npos);
+  EXPECT_NE(message({"sh", "-c", "echo broken >&2; exit 4", "sh"}).find("exit 4"), std::string::npos);
+  EXPECT_NE(message({"sh", "-c", "true", "sh"}).find("the runner failed"), std::string::npos);  // no result
+  EXPECT_NE(message({"sh", "-c", "echo '{not json' > \"$2\"", "sh"}).find("unreadable runner result"),
+            std::string::npos);
 }
 
 TEST(OnnxRuntimeRunner, TimesRepeatedRunsAndReportsAModelItCannotLoadByName) {
