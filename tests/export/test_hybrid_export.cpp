@@ -157,7 +157,9 @@ TEST(HybridExport, WritesEveryPatternTheSelectorAndTheManifestAndVerifies) {
     EXPECT_EQ(p["macs"].get<int64_t>(), patterns.cost(k, 12, 10).macs);
     EXPECT_DOUBLE_EQ(p["channel_fraction"].get<double>(), h.pool.channel_fraction(k));
     EXPECT_DOUBLE_EQ(p["latency_ms"].get<double>(), h.latency.median_ms[k]);
-    if (k > 0) EXPECT_LT(p["macs"].get<int64_t>(), m["patterns"][k - 1]["macs"].get<int64_t>());
+    if (k > 0) {
+      EXPECT_LT(p["macs"].get<int64_t>(), m["patterns"][k - 1]["macs"].get<int64_t>());
+    }
   }
   EXPECT_TRUE(std::filesystem::exists(dir / "deploy" / m["selector"]["file"].get<std::string>()));
   EXPECT_EQ(m["selector"]["inputs"][0]["name"], kSelectorInfoInput);
