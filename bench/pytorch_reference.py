@@ -133,27 +133,42 @@ def inference(net, width, height, layout, warmup, runs):
 
 
 def training_steps_per_second(layout, batch, patch, steps, warmup, scale=2):
+    """Steps per second, and the milliseconds of a step spent in each phase."""
     torch.manual_seed(0)
     fmt = torch.channels_last if layout == "nhwc" else torch.contiguous_format
     model = Network().to(memory_format=fmt).train()
     optimizer = torch.optim.Adam(model.parameters(), lr=1e-3)
     lr = torch.rand(batch, 3, patch, patch).contiguous(memory_format=fmt)
     hr = torch.rand(batch, 3, patch * scale, patch * scale).contiguous(memory_format=fmt)
+    phases = {"forward_and_loss": 0.0, "backward": 0.0, "clip": 0.0, "optimizer": 0.0}
 
-    def step():
+    def step(record):
+        t = [time.perf_counter()]
+
+        def lap(name):
+            now = time.perf_counter()
+            if record:
+                phases[name] += now - t[0]
+            t[0] = now
+
         out = model(lr)
         loss = F.mse_loss(out, hr)
+        lap("forward_and_loss")
         optimizer.zero_grad()
         loss.backward()
+        lap("backward")
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        lap("clip")
         optimizer.step()
+        lap("optimizer")
 
     for _ in range(warmup):
-        step()
+        step(False)
     start = time.perf_counter()
     for _ in range(steps):
-        step()
-    return steps / (time.perf_counter() - start)
+        step(True)
+    rate = steps / (time.perf_counter() - start)
+    return rate, {k: 1e3 * v / steps for k, v in phases.items()}
 
 
 def main():
@@ -166,6 +181,7 @@ def main():
     p.add_argument("--patch", type=int, default=24, help="LR training patch side")
     p.add_argument("--train-steps", type=int, default=60, help="timed training steps per layout")
     p.add_argument("--torchscript", default="", help="cgsr export of PAN x2 whose weights to use")
+    p.add_argument("--only", choices=("inference", "training"), help="time one of the two")
     a = p.parse_args()
     torch.set_num_threads(a.threads)
     width, height = (int(v) for v in a.input.split("x"))
@@ -173,13 +189,19 @@ def main():
     result = {"torch": torch.__version__, "threads": a.threads, "input": a.input}
     if a.torchscript:
         result["max_abs_diff_vs_export"] = load_exported(net, a.torchscript, width, height)
-    result["inference_ms"] = {
-        layout: inference(net, width, height, layout, a.warmup, a.runs) for layout in ("nchw", "nhwc")
-    }
-    result["train_steps_per_second"] = {
+    if a.only != "training":
+        result["inference_ms"] = {
+            layout: inference(net, width, height, layout, a.warmup, a.runs) for layout in ("nchw", "nhwc")
+        }
+    if a.only == "inference":
+        print(json.dumps(result))
+        return
+    training = {
         layout: training_steps_per_second(layout, a.batch, a.patch, a.train_steps, a.warmup)
         for layout in ("nchw", "nhwc")
     }
+    result["train_steps_per_second"] = {layout: rate for layout, (rate, _) in training.items()}
+    result["train_ms_per_step"] = {layout: phases for layout, (_, phases) in training.items()}
     result["train"] = {"batch": a.batch, "patch": a.patch, "steps": a.train_steps}
     print(json.dumps(result))
 
