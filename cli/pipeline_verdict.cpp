@@ -123,16 +123,19 @@ void check_dynamic_pruning(Verdict& v, const EvalResult& hybrid, const EvalResul
                       used >= options.min_patterns_used, choices ? usage_text(*choices) : "no frame recorded a pattern"});
 }
 
+void check_beats_bicubic(Verdict& v, const std::vector<const EvalResult*>& networks, const EvalResult& bicubic,
+                         const std::string& where) {
+  for (const EvalResult* n : networks)
+    v.checks.push_back({n->name + " beats bicubic" + where, n->psnr > bicubic.psnr,
+                        fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", n->psnr, bicubic.psnr,
+                                    n->psnr - bicubic.psnr)});
+}
+
 }  // namespace
 
 Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) {
   Verdict v;
-  if (r.bicubic) {
-    for (const EvalResult* n : r.networks())
-      v.checks.push_back({n->name + " beats bicubic", n->psnr > r.bicubic->psnr,
-                          fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", n->psnr, r.bicubic->psnr,
-                                      n->psnr - r.bicubic->psnr)});
-  }
+  if (r.bicubic) check_beats_bicubic(v, r.networks(), *r.bicubic, "");
   if (r.control && r.cg_enhanced) {
     check_gain(v, "overall", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr, r.control->psnr,
                options.min_enhance_gain_db);
@@ -142,6 +145,13 @@ Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) 
   if (r.cg_enhanced && r.cg_optimized) check_cuts(v, "search", *r.cg_enhanced, *r.cg_optimized, options.max_search_loss_db);
   if (r.cg_optimized && r.pruned) check_cuts(v, "pruning", *r.cg_optimized, *r.pruned, options.max_prune_loss_db);
   if (r.pruned && r.pruned_static) check_dynamic_pruning(v, *r.pruned, *r.pruned_static, r.magnitude, options);
+  for (const auto& h : r.heldout) {
+    if (h.bicubic) {
+      check_beats_bicubic(v, h.networks, *h.bicubic, " on held-out scene '" + h.scene + "'");
+    } else {
+      v.checks.push_back({"bicubic evaluated on held-out scene '" + h.scene + "'", false, "no bicubic row there"});
+    }
+  }
   return v;
 }
 

@@ -13,7 +13,8 @@
 //     turn) is at most `max_hybrid_latency_ratio` of its static network's, it loses at most
 //     `max_hybrid_loss_db` against the static network, gains at least
 //     `min_hybrid_gain_over_magnitude_db` over magnitude pruning at its mean MACs, and uses at
-//     least `min_patterns_used` patterns on the test frames.
+//     least `min_patterns_used` patterns on the test frames;
+//   - on every held-out scene (one the networks never trained on), every network beats bicubic.
 // Every figure in a check's detail comes from the evaluations; the thresholds are the config's.
 
 #include <nlohmann/json.hpp>
@@ -38,6 +39,13 @@ struct VerdictOptions {
 };
 config::Schema<VerdictOptions> verdict_schema();
 
+// A held-out scene's evaluations: bicubic and the run's networks there.
+struct HeldoutScene {
+  std::string scene;
+  const EvalResult* bicubic = nullptr;
+  std::vector<const EvalResult*> networks;
+};
+
 // The evaluations a verdict needs, by role; a role left null is not checked.
 struct PipelineResults {
   const EvalResult* bicubic = nullptr;
@@ -48,6 +56,7 @@ struct PipelineResults {
   const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network
   const EvalResult* pruned_static = nullptr;  // the hybrid model's static network alone
   const EvalResult* magnitude = nullptr;     // magnitude pruning at the hybrid's mean MACs
+  std::vector<HeldoutScene> heldout;
   std::vector<const EvalResult*> networks() const;  // every non-null learned model
 };
 

@@ -57,17 +57,28 @@ nlohmann::ordered_json run_report(const ReportOptions& options, RunDir& run_dir)
   return write_report(collect_evaluations(options.runs), run_dir);
 }
 
-nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir) {
+nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
+                                    const std::vector<std::string>& heldout_scenes) {
   const auto tables = group_results(evaluations);
   std::string markdown;
   nlohmann::ordered_json results;
   results["tables"] = nlohmann::ordered_json::array();
   for (const auto& t : tables) {
+    const bool heldout = std::find(heldout_scenes.begin(), heldout_scenes.end(), t.dataset) != heldout_scenes.end();
+    if (heldout)
+      markdown += "## Held-out scene: " + t.dataset +
+                  "\n\nNot in the training data: how the networks do on content they never saw (quality only; "
+                  "latency is the run's own table's).\n\n";
     markdown += report_markdown(t) + "\n";
-    const std::string plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale) + ".png";
-    write_report_plot(run_dir.file(plot), t);
-    markdown += "![PSNR against latency](" + plot + ")\n\n";
-    results["tables"].push_back({{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}});
+    // A plot of PSNR against latency needs a latency (held-out scenes are evaluated for quality only).
+    std::string plot;
+    if (std::any_of(t.rows.begin(), t.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); })) {
+      plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale) + ".png";
+      write_report_plot(run_dir.file(plot), t);
+      markdown += "![PSNR against latency](" + plot + ")\n\n";
+    }
+    results["tables"].push_back(
+        {{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}, {"heldout", heldout}});
     // Models that choose a pattern per frame: the choice next to each frame's edge density.
     for (size_t i = 0; i < t.rows.size(); ++i) {
       const auto choices = pattern_choices(t.rows[i]);

@@ -34,7 +34,7 @@ namespace cgsr::cli {
 
 const std::vector<std::string>& pipeline_stages() {
   static const std::vector<std::string> stages = {"render", "train",  "enhance", "control", "search",
-                                                  "prune",  "export", "eval",    "report"};
+                                                  "prune",  "export", "eval",    "heldout", "report"};
   return stages;
 }
 
@@ -51,6 +51,8 @@ config::Schema<PipelineOptions> pipeline_schema() {
   s.block("prune", &PipelineOptions::prune, "cgsr prune config (model, data, eval filled in)");
   s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in (onnx, torchscript)");
   s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames; latency_runs: rounds of the report's side-by-side timing)");
+  s.section("heldout", &PipelineOptions::heldout, heldout_schema(),
+            "scenes not in the training data, on which every model and classic baseline is evaluated");
   s.section("verdict", &PipelineOptions::verdict, verdict_schema(), "what the run must show");
   s.field("from", &PipelineOptions::from, "rerun this stage and every later one").check(
       [](const std::string& v) {
@@ -223,7 +225,9 @@ void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<st
 
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
   const auto t0 = std::chrono::steady_clock::now();
-  StageRunner stages(root, options.from, static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1));
+  const bool heldout = !options.heldout.scenes.empty();
+  StageRunner stages(root, options.from,
+                     static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1) - (heldout ? 0 : 1));
   nlohmann::ordered_json results;
   results["config"] = yaml_to_json(resolved);
   // No references into `results`: an ordered_json object is a vector, and inserting moves it.
@@ -385,6 +389,28 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
                                     [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
   record("eval", evaluated);
 
+  // heldout: every model of the run and the classic baselines on scenes it never trained on
+  StageOutcome heldout_stage;
+  if (heldout) {
+    HeldoutJob job;
+    job.models = evaluation.models;
+    job.models.push_back(searched_file.string());
+    for (const auto& b : prune_roles.baselines) job.models.push_back(b.file.string());
+    job.models.push_back(pruned_file.string());
+    job.scale = backbone.scale;
+    job.lr = lr;
+    job.training_scene = data.info().name;
+    job.eval = stage_eval;
+    job.seed = options.seed;
+    job.threads = options.threads;
+    YAML::Node config = heldout_schema().emit(options.heldout);
+    config["models"] = job.models;
+    heldout_stage = stages.run("heldout", config, {trained.hash, controlled.hash, enhance.hash, searched.hash, pruned.hash},
+                               [&](RunDir& dir, bool) { return run_heldout(options.heldout, job, dir.path()); });
+    record("heldout", heldout_stage);
+  }
+  const std::vector<std::string> heldout_runs = heldout_result_files(heldout_stage.summary);
+
   // report: one table and plot of every model. The stages timed their models minutes or hours
   // apart, under whatever else the machine was doing then; the report times them again side by
   // side, in interleaved rounds over the test frames in turn, so that their latencies compare.
@@ -404,9 +430,12 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   }
   const std::vector<std::string> runs = {(stages.dir("eval") / "results.json").string(),
                                          (stages.dir("prune") / "results.json").string()};
+  std::vector<std::string> report_runs = runs;
+  report_runs.insert(report_runs.end(), heldout_runs.begin(), heldout_runs.end());
   const auto reported = stages.run(
-      "report", YAML::Node(runs), {evaluated.hash, pruned.hash, exported.hash}, [&](RunDir& dir, bool) {
-        std::vector<EvalResult> evaluations = collect_evaluations(runs);
+      "report", YAML::Node(report_runs), {evaluated.hash, pruned.hash, exported.hash, heldout_stage.hash},
+      [&](RunDir& dir, bool) {
+        std::vector<EvalResult> evaluations = collect_evaluations(runs);  // timed below; the held-out ones are not
         if (eval.latency_runs > 0) {
           std::vector<std::unique_ptr<Upscaler>> upscalers;
           std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
@@ -435,12 +464,17 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
           for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
           time_in_onnxruntime(evaluations, onnx_files, frames, eval.latency_runs);
         }
-        return write_report(evaluations, dir);
+        const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
+        evaluations.insert(evaluations.end(), unseen.begin(), unseen.end());
+        return write_report(evaluations, dir, heldout_scenes(heldout_stage.summary));
       });
   record("report", reported);
   if (reported.skipped) std::printf("%s", read_file(stages.dir("report") / "report.md").c_str());
 
-  const std::vector<EvalResult> evaluations = collect_evaluations({(stages.dir("report") / "results.json").string()});
+  // The run's own rows are those of its data set; the held-out scenes' rows share their names.
+  std::vector<EvalResult> evaluations, unseen;
+  for (auto& e : collect_evaluations({(stages.dir("report") / "results.json").string()}))
+    (e.dataset == data.info().name ? evaluations : unseen).push_back(std::move(e));
   PipelineResults roles;
   roles.bicubic = find_result(evaluations, "bicubic");
   roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
@@ -453,6 +487,17 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
     throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + prune_roles.input.name + ")",
                 ErrorKind::Internal);
+  for (const auto& scene : heldout_scenes(heldout_stage.summary)) {
+    const auto row = [&](const std::string& name) -> const EvalResult* {
+      for (const auto& e : unseen)
+        if (e.dataset == scene && e.name == name) return &e;
+      return nullptr;
+    };
+    HeldoutScene h{scene, row("bicubic"), {}};
+    for (const EvalResult* n : roles.networks())
+      if (const EvalResult* r = row(n->name)) h.networks.push_back(r);
+    roles.heldout.push_back(std::move(h));
+  }
   const Verdict verdict = judge_pipeline(roles, options.verdict);
   write_file_atomic(root / "verdict.txt", verdict.text());
   results["verdict"] = verdict.to_json();

@@ -10,6 +10,8 @@
 //   prune    hybrid pruning + magnitude baseline              DIR/prune
 //   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
 //   eval     classic baselines, backbone, control and CG-enhanced on the test split  DIR/eval
+//   heldout  scenes not in the training data (when `heldout.scenes` names any): every model and
+//            the classic baselines on each (cli/heldout_evaluation.h)        DIR/heldout
 //   report   every model timed again side by side; table, plot  DIR/report/report.md
 //            and the verdict (cli/pipeline_verdict.h)             DIR/verdict.txt
 //
@@ -25,6 +27,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/heldout_evaluation.h"
 #include "cli/pipeline_verdict.h"
 #include "export/export_format.h"
 
@@ -38,6 +41,7 @@ struct PipelineOptions : RunSettings {
   config::Block train, enhance, search, prune;      // the subcommands' configs, paths filled in
   std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
   config::Block eval;                // EvalOptions shared by the eval and prune stages
+  HeldoutOptions heldout;            // scenes never trained on, evaluated with every model
   VerdictOptions verdict;
   std::string from;                  // rerun this stage and every later one
 };

@@ -42,7 +42,16 @@ struct Story {
   EvalResult cg = result("CG", 26.2, 280000, 21000000, 110.0, 20.5);
   EvalResult opt = result("OPT", 26.1, 150000, 11000000, 60.0);
   EvalResult pruned = result("P", 26.0, 60000, 4000000, 30.0);
-  PipelineResults roles() const { return {&bicubic, &pan, &control, &cg, &opt, &pruned}; }
+  PipelineResults roles() const {
+    PipelineResults r;
+    r.bicubic = &bicubic;
+    r.backbone = &pan;
+    r.control = &control;
+    r.cg_enhanced = &cg;
+    r.cg_optimized = &opt;
+    r.pruned = &pruned;
+    return r;
+  }
 };
 }  // namespace
 
@@ -162,4 +171,25 @@ TEST(PipelineVerdict, TheDynamicPartMustPayAgainstItsStaticNetworkAndMagnitudePr
   EvalResult untimed = good;
   untimed.latency.reset();
   EXPECT_FALSE(find(judge(untimed), "H runs at most 0.8x its static network's mean latency")->passed);
+}
+
+TEST(PipelineVerdict, EveryNetworkMustBeatBicubicOnEveryHeldOutScene) {
+  const Story s;
+  // On the held-out scene bicubic does better than in the run's own scene: PAN loses to it.
+  const EvalResult bicubic = result("bicubic", 35.3, 0, 0, 0);
+  const EvalResult pan = result("PAN", 35.1, 272000, 20000000, 0);
+  const EvalResult cg = result("CG", 35.5, 280000, 21000000, 0);
+  PipelineResults r = s.roles();
+  r.heldout.push_back({"level", &bicubic, {&pan, &cg}});
+  const Verdict v = judge_pipeline(r, VerdictOptions{});
+  EXPECT_EQ(v.checks.size(), 15u + 2u);
+  EXPECT_FALSE(find(v, "PAN beats bicubic on held-out scene 'level'")->passed);
+  EXPECT_NE(find(v, "PAN beats bicubic on held-out scene 'level'")->detail.find("-0.200 dB"), std::string::npos);
+  EXPECT_TRUE(find(v, "CG beats bicubic on held-out scene 'level'")->passed);
+  EXPECT_EQ(v.failed(), 1) << v.text();
+
+  // A held-out scene without its bicubic row is a failed check, not a silent pass.
+  PipelineResults missing = s.roles();
+  missing.heldout.push_back({"level", nullptr, {&pan}});
+  EXPECT_FALSE(find(judge_pipeline(missing, VerdictOptions{}), "bicubic evaluated on held-out scene 'level'")->passed);
 }

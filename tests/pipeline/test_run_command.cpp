@@ -1,6 +1,7 @@
 // `cgsr run` end to end on the tiny scene with tiny schedules: every stage leaves its artifacts
 // and a finished-stage record, a rerun skips everything, `--from` and a changed stage config
-// rerun exactly the stages they should, and a stage's config error names the run config's key.
+// rerun exactly the stages they should, a held-out scene gets its section and verdict checks, and
+// a stage's config error names the run config's key.
 // The CG-enhanced network reads HR rendering information through both HR sources, so search,
 // pruning, export and the report all handle the second input.
 #include <gtest/gtest.h>
@@ -42,13 +43,34 @@ prune:
     epochs: 0
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 eval: {max_frames: 2, latency_runs: 1}
+heldout: {scenes: [HELDOUT], frames: 2}
 verdict: {fail_run: false}
 )";
 
-// The pipeline config above, on the tiny scene, written into `dir`.
+// A scene the networks never train on: another room of the tiny scene's kind.
+const char* kHeldoutScene = R"(name: tiny-heldout
+frames: 6
+resolutions: [32x24, 64x48]
+shadows: false
+scene:
+  type: procedural
+  name: tiny-heldout
+  layout: room
+  size: [7, 6]
+  cell: 2.0
+  texture_size: 32
+  texel_density: 40
+  props: {crates: 2, pillars: 0, spheres: 2, tori: 0, stairs: 0, fences: 0, railings: 1, wires: 2, signs: 1}
+  lighting: {point_lights: 2, shadows: false}
+  camera: {steps: 4}
+)";
+
+// The pipeline config above, on the tiny scene with the held-out scene, written into `dir`.
 fs::path write_config(const fs::path& dir) {
   std::string config = kConfig;
   config.replace(config.find("SCENE"), 5, std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
+  std::ofstream(dir / "heldout.yaml") << kHeldoutScene;
+  config.replace(config.find("HELDOUT"), 7, (dir / "heldout.yaml").string());
   const auto file = dir / "pipeline.yaml";
   std::ofstream(file) << config;
   return file;
@@ -57,7 +79,8 @@ fs::path write_config(const fs::path& dir) {
 // Stage name -> "ran" / "skipped", from the log lines of one cgsr run.
 std::map<std::string, std::string> stage_actions(const std::string& log) {
   std::map<std::string, std::string> out;
-  for (const std::string stage : {"render", "train", "enhance", "control", "search", "prune", "export", "eval", "report"}) {
+  for (const std::string stage :
+       {"render", "train", "enhance", "control", "search", "prune", "export", "eval", "heldout", "report"}) {
     if (log.find("] " + stage + ": up to date") != std::string::npos)
       out[stage] = "skipped";
     else if (log.find("] " + stage + ": done in") != std::string::npos)
@@ -86,12 +109,14 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   const CliResult first = run_cgsr(args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   for (const auto& [stage, action] : stage_actions(first.err)) EXPECT_EQ(action, "ran") << stage;
-  EXPECT_EQ(stage_actions(first.err).size(), 9u) << first.err;
-  for (const std::string stage : {"data", "train", "enhance", "control", "search", "prune", "export", "eval", "report"})
+  EXPECT_EQ(stage_actions(first.err).size(), 10u) << first.err;
+  for (const std::string stage :
+       {"data", "train", "enhance", "control", "search", "prune", "export", "eval", "heldout", "report"})
     EXPECT_TRUE(read_json(out / stage / "stage.json")["done"].get<bool>()) << stage;
   for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "control/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
                                  "export/cg_optimized.onnx", "export/pruned/pattern_0.onnx", "export/pruned/selector.onnx",
                                  "export/pruned/manifest.json", "export/pruned_torchscript/pattern_0.pt",
+                                 "heldout/1_heldout/data/manifest.yaml", "heldout/1_heldout/eval/results.json",
                                  "report/report.md", "verdict.txt", "results.json", "log.txt"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
 
@@ -104,22 +129,44 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   EXPECT_GE(results["verdict"]["checks"].size(), 15u);
   EXPECT_NE(first.out.find("verdict:"), std::string::npos);
 
+  // The held-out scene, rendered at the training data's sizes, has its own section with every
+  // model and classic baseline (quality only), and the verdict checks each network against
+  // bicubic there.
+  EXPECT_TRUE(fs::exists(out / "heldout" / "1_heldout" / "data" / "128x96"));  // its config says 32x24, 64x48
+  EXPECT_FALSE(fs::exists(out / "heldout" / "1_heldout" / "data" / "32x24"));
+  const size_t section = report.find("## Held-out scene: tiny-heldout");
+  ASSERT_NE(section, std::string::npos) << report;
+  for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2", "CG-optimized PAN x2",
+                                "CG-optimized PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
+    EXPECT_NE(report.find("| " + row + " ", section), std::string::npos) << row << "\n" << report;
+  int heldout_checks = 0;
+  for (const auto& check : results["verdict"]["checks"])
+    heldout_checks += check["claim"].get<std::string>().find("on held-out scene 'tiny-heldout'") != std::string::npos;
+  EXPECT_EQ(heldout_checks, 5);  // PAN, its control, CG-enhanced, CG-optimized, the hybrid
+
   // A rerun finds every stage finished.
   const CliResult again = run_cgsr(args);
   ASSERT_EQ(again.exit_code, 0) << again.err;
   for (const auto& [stage, action] : stage_actions(again.err)) EXPECT_EQ(action, "skipped") << stage;
-  EXPECT_EQ(stage_actions(again.err).size(), 9u);
+  EXPECT_EQ(stage_actions(again.err).size(), 10u);
   EXPECT_NE(again.out.find("verdict:"), std::string::npos);  // still printed
 
-  // --from eval reruns eval and report only.
+  // --from eval reruns eval, heldout and report only.
   expect_actions(run_cgsr(args + " --from eval"),
-                 {{"prune", "skipped"}, {"export", "skipped"}, {"eval", "ran"}, {"report", "ran"}});
+                 {{"prune", "skipped"}, {"export", "skipped"}, {"eval", "ran"}, {"heldout", "ran"}, {"report", "ran"}});
+
+  // A held-out scene that is the training scene is an error naming its config.
+  const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
+  const CliResult same = run_cgsr(args + " --set \"heldout.scenes=[" + tiny + "]\"");
+  EXPECT_NE(same.exit_code, 0);
+  EXPECT_NE(same.err.find(tiny), std::string::npos) << same.err;
+  EXPECT_NE(same.err.find("as the training data is"), std::string::npos) << same.err;
 
   // A changed search config reruns search and what depends on it, not the trainings before it,
   // nor eval (which reads neither search nor prune).
   expect_actions(run_cgsr(args + " --set search.final.steps=3"),
                  {{"train", "skipped"}, {"enhance", "skipped"}, {"control", "skipped"}, {"search", "ran"}, {"prune", "ran"},
-                  {"eval", "skipped"}, {"report", "ran"}});
+                  {"eval", "skipped"}, {"heldout", "ran"}, {"report", "ran"}});
   fs::remove_all(dir);
 }
 
