@@ -75,24 +75,30 @@ std::string report_markdown(const ReportTable& table) {
   const auto with_edges = std::find_if(table.rows.begin(), table.rows.end(),
                                        [](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
   const bool edges = with_edges != table.rows.end();
-  md << "| Model | Params (k) | MACs (G) | Latency (ms) |" << (ort ? " ONNX Runtime (ms) |" : "") << " PSNR (dB) |"
-     << (edges ? " Edge PSNR (dB) | Rest PSNR (dB) |" : "") << " SSIM | Temporal error (x1e-3) |\n";
-  md << "|---|---:|---:|---:|" << (ort ? "---:|" : "") << "---:|" << (edges ? "---:|---:|" : "") << "---:|---:|\n";
+  // A table evaluated for quality only (latency_runs 0, a held-out scene) has no latency column.
+  const bool timed = std::any_of(table.rows.begin(), table.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); });
+  md << "| Model | Params (k) | MACs (G) |" << (timed ? " Latency (ms) |" : "") << (ort ? " ONNX Runtime (ms) |" : "")
+     << " PSNR (dB) |" << (edges ? " Edge PSNR (dB) | Rest PSNR (dB) |" : "") << " SSIM | Temporal error (x1e-3) |\n";
+  md << "|---|---:|---:|" << (timed ? "---:|" : "") << (ort ? "---:|" : "") << "---:|" << (edges ? "---:|---:|" : "")
+     << "---:|---:|\n";
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
     const auto c = cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-    md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | " << c.latency
-       << " | " << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
+    md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | "
+       << (timed ? c.latency + " | " : "") << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
        << (edges ? c.psnr_edge + " | " + c.psnr_rest + " | " : "") << c.ssim << " | " << c.temporal << " |\n";
   }
   if (first.temporal_error_reference)
     md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
        << "e-3. ";
-  md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
-        "of repeated runs on this machine"
-     << (ort ? " (cgsr's own inference; ONNX Runtime: the exported file on the same input)" : "") << ".\n";
+  if (timed)
+    md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
+          "of repeated runs on this machine"
+       << (ort ? " (cgsr's own inference; ONNX Runtime: the exported file on the same input)" : "") << ".\n";
+  else
+    md << "\nMACs at the evaluated LR size.\n";
   if (edges) {
     md << "Edge PSNR: on the HR geometry-edge pixels grown by one pixel";
     if (with_edges->edge_fraction) md << " (" << fixed(100.0 * *with_edges->edge_fraction, 1) << "% of the pixels)";

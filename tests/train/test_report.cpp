@@ -57,6 +57,16 @@ TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
   EXPECT_NE(csv.find("hall,2,pan,261403,261403000,12.0000,33.4560"), std::string::npos) << csv;
 }
 
+TEST(Report, ALatencyColumnOnlyWhenSomeRowWasTimed) {
+  // A held-out scene is evaluated for quality only: no latency column, no Pareto front.
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, std::nullopt), row("pan", 33.456, std::nullopt, 261403)}};
+  const auto md = report_markdown(t);
+  EXPECT_NE(md.find("| Model | Params (k) | MACs (G) | PSNR (dB) | SSIM |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| pan | 261.4 | 0.26 | 33.46 | 0.9000 |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("Latency"), std::string::npos) << md;
+  EXPECT_EQ(md.find("Pareto"), std::string::npos) << md;
+}
+
 TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
   ReportTable plain{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}};
   EXPECT_EQ(report_markdown(plain).find("Edge PSNR"), std::string::npos);
