@@ -223,294 +223,362 @@ void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<st
 }
 }  // namespace
 
-nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const bool heldout = !options.heldout.scenes.empty();
-  StageRunner stages(root, options.from,
-                     static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1) - (heldout ? 0 : 1));
-  nlohmann::ordered_json results;
-  results["config"] = yaml_to_json(resolved);
-  // No references into `results`: an ordered_json object is a vector, and inserting moves it.
-  auto record = [&](const std::string& stage, const StageOutcome& o) {
-    results["stages"][stage] = o.summary;
-    results["stage_seconds"][stage] = o.skipped ? nlohmann::ordered_json("cached") : nlohmann::ordered_json(o.seconds);
-  };
+namespace {
+
+// The pipeline's stages as named steps over shared state: each step runs (or skips) its stage and
+// leaves what later stages read (model files, stage hashes, summaries).
+class Pipeline {
+ public:
+  Pipeline(const PipelineOptions& options, const YAML::Node& resolved, fs::path root)
+      : options_(options),
+        root_(std::move(root)),
+        stages_(root_, options.from,
+                static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1) -
+                    (options.heldout.scenes.empty() ? 1 : 0)) {
+    results_["config"] = yaml_to_json(resolved);
+    parse_stage_options();
+  }
+
+  nlohmann::ordered_json run() {
+    const auto t0 = std::chrono::steady_clock::now();
+    render();
+    train_networks();
+    search();
+    prune();
+    export_networks();
+    evaluate();
+    evaluate_heldout();
+    report();
+    const Verdict verdict = judge();
+    write_file_atomic(root_ / "verdict.txt", verdict.text());
+    results_["verdict"] = verdict.to_json();
+    results_["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    write_file_atomic(root_ / "results.json", results_.dump(2) + "\n");
+
+    std::printf("\n%s", verdict.text().c_str());
+    std::printf("report: %s, verdict: %s, run: %s (%.0f s)\n", (stages_.dir("report") / "report.md").string().c_str(),
+                (root_ / "verdict.txt").string().c_str(), root_.string().c_str(), results_["seconds"].get<double>());
+    if (!verdict.passed() && options_.verdict.fail_run)
+      throw Error(root_.string(), "the verdict failed " + std::to_string(verdict.failed()) + " check(s) (see verdict.txt)",
+                  ErrorKind::Internal);
+    return results_;
+  }
+
+ private:
+  // No references into `results_`: an ordered_json object is a vector, and inserting moves it.
+  void record(const std::string& stage, const StageOutcome& o) {
+    results_["stages"][stage] = o.summary;
+    results_["stage_seconds"][stage] = o.skipped ? nlohmann::ordered_json("cached") : nlohmann::ordered_json(o.seconds);
+  }
+
+  fs::path model_file(const std::string& stage) const {
+    return stages_.dir(stage) / (stage == "prune" ? "pruned.cgsr" : "model.cgsr");
+  }
 
   // Every stage's options first, so that a mistake anywhere in the config stops the run before
   // its first stage rather than after an hour of training.
-  const bool render = options.data.empty();
-  const std::string data_path = render ? stages.dir("render").string() : options.data;
-  const fs::path backbone_file = stages.dir("train") / "model.cgsr";
-  const fs::path enhanced_file = stages.dir("enhance") / "model.cgsr";
-  const fs::path control_file = stages.dir("control") / "model.cgsr";
-  const fs::path searched_file = stages.dir("search") / "model.cgsr";
-  const fs::path pruned_file = stages.dir("prune") / "pruned.cgsr";
-  RenderOptions scene;
-  if (render) {
-    scene = config::parse_document(config::Document::load_file(options.scene), render_schema());
-    scene.seed = options.seed;
-    scene.threads = options.threads;
-  }
-  YAML::Node with_data = run_settings_node(options);
-  with_data["data"] = data_path;
-  TrainOptions backbone = parse_stage(options.train, train_schema(), with_data, "train");
-  YAML::Node enhance_filled = YAML::Clone(with_data);
-  enhance_filled["model"] = backbone_file.string();
-  TrainOptions enhanced = parse_stage(options.enhance, train_schema(), enhance_filled, "enhance");
-  enhanced.enhance.enabled = true;
-  TrainOptions control = enhanced;  // same start, schedule, loss and seed; no rendering information
-  control.enhance.enabled = false;
-  YAML::Node search_filled = YAML::Clone(with_data);
-  search_filled["parent"] = enhanced_file.string();
-  SearchCommandOptions search = parse_stage(options.search, search_command_schema(), search_filled, "search");
-  const EvalOptions eval = parse_stage(options.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
-  // The stages that evaluate (prune, eval) leave latency out: the report stage times every model
-  // side by side, which is the only timing that compares, so timing them earlier would be wasted.
-  EvalOptions stage_eval = eval;
-  stage_eval.latency_runs = 0;
-  YAML::Node prune_filled = YAML::Clone(with_data);
-  prune_filled["model"] = searched_file.string();
-  prune_filled["eval"] = eval_schema_fields().emit(stage_eval);
-  PruneCommandOptions prune = parse_stage(options.prune, prune_command_schema(), prune_filled, "prune");
-
-  // render
-  std::string data_hash;
-  if (render) {
-    const auto o = stages.run("render", render_schema().emit(scene), {}, [&](RunDir& dir, bool) {
-      return run_render(scene, dir.path());
-    });
-    record("render", o);
-    data_hash = o.hash;
-  } else {
-    data_hash = stage_hash(YAML::Node(fs::absolute(options.data).string()), {});
-  }
-  const Dataset data = Dataset::open(data_path);
-
-  // train: the plain backbone
-  const auto trained = stages.run("train", train_schema().emit(backbone), {data_hash}, [&](RunDir& dir, bool resume) {
-    backbone.resume = resume;
-    return run_train(backbone, train_schema().emit(backbone), dir);
-  });
-  record("train", trained);
-
-  // enhance: backbone + RIT (+ geometry head), trained with the joint loss
-  const auto enhance = stages.run("enhance", train_schema().emit(enhanced), {data_hash, trained.hash},
-                                  [&](RunDir& dir, bool resume) {
-                                    enhanced.resume = resume;
-                                    return run_train(enhanced, train_schema().emit(enhanced), dir);
-                                  });
-  record("enhance", enhance);
-
-  // control: the plain backbone trained on as long as the CG-enhanced network was
-  control.name = trained.summary.at("name").get<std::string>() + " (control)";
-  const auto controlled = stages.run("control", train_schema().emit(control), {data_hash, trained.hash},
-                                     [&](RunDir& dir, bool resume) {
-                                       control.resume = resume;
-                                       return run_train(control, train_schema().emit(control), dir);
-                                     });
-  record("control", controlled);
-
-  // search: CG-enhanced -> CG-optimized
-  const auto searched = stages.run("search", search_command_schema().emit(search), {data_hash, enhance.hash},
-                                   [&](RunDir& dir, bool resume) {
-                                     search.resume = resume;
-                                     return run_search_command(search, search_command_schema().emit(search), dir);
-                                   });
-  record("search", searched);
-
-  // prune: hybrid pruning of the CG-optimized network (evaluated with the pipeline's eval options)
-  const auto pruned = stages.run("prune", prune_command_schema().emit(prune), {data_hash, searched.hash},
-                                 [&](RunDir& dir, bool resume) {
-                                   prune.resume = resume;
-                                   return run_prune(prune, prune_command_schema().emit(prune), dir);
-                                 });
-  record("prune", pruned);
-
-  // export: the CG-optimized and the pruned network, verified in the other runtimes
-  const PruneRoles prune_roles =
-      prune_roles_from_json(pruned.summary.at("roles"), (stages.dir("prune") / "results.json").string());
-  const Resolution lr = data.info().resolutions.front();
-  std::vector<ExportCommandOptions> exports;
-  YAML::Node export_config(YAML::NodeType::Sequence);
-  // The CG-optimized and pruned networks go out in every format; the others as ONNX only, for
-  // the report's ONNX Runtime latency column. Each file is named after its role; the hybrid model
-  // goes out as its deployment directory (a file per pattern, the selector, the manifest).
-  std::vector<std::pair<fs::path, std::string>> to_export = {
-      {backbone_file, "backbone"}, {enhanced_file, "cg_enhanced"}, {searched_file, "cg_optimized"}};
-  for (const auto& b : prune_roles.baselines) to_export.emplace_back(b.file, b.file.stem().string());
-  to_export.emplace_back(pruned_file, "pruned");
-  std::map<std::string, fs::path> onnx_of_file;  // model file -> its exported ONNX file
-  for (const auto& [model, stem] : to_export) {
-    const bool deployed = stem == "cg_optimized" || stem == "pruned";
-    for (const auto& format : options.export_formats) {
-      if (!deployed && format != ExportFormat::Onnx) continue;
-      ExportCommandOptions e;
-      e.seed = options.seed;
-      e.threads = options.threads;
-      e.model = model.string();
-      e.format = format;
-      e.input = lr.name();
-      e.verify = true;
-      const bool onnx = format == ExportFormat::Onnx;
-      e.out = (stages.dir("export") / (model == pruned_file ? stem + (onnx ? "" : "_torchscript")
-                                                            : stem + (onnx ? ".onnx" : ".pt")))
-                  .string();
-      // The hybrid's pattern 0 is its static network.
-      if (onnx)
-        onnx_of_file[model.string()] = model == pruned_file ? fs::path(e.out) / pattern_file_name(0, format) : fs::path(e.out);
-      exports.push_back(e);
-      export_config.push_back(export_schema().emit(e));
+  void parse_stage_options() {
+    rendering_ = options_.data.empty();
+    data_path_ = rendering_ ? stages_.dir("render").string() : options_.data;
+    if (rendering_) {
+      scene_ = config::parse_document(config::Document::load_file(options_.scene), render_schema());
+      scene_.seed = options_.seed;
+      scene_.threads = options_.threads;
     }
+    YAML::Node with_data = run_settings_node(options_);
+    with_data["data"] = data_path_;
+    backbone_ = parse_stage(options_.train, train_schema(), with_data, "train");
+    YAML::Node enhance_filled = YAML::Clone(with_data);
+    enhance_filled["model"] = model_file("train").string();
+    enhanced_ = parse_stage(options_.enhance, train_schema(), enhance_filled, "enhance");
+    enhanced_.enhance.enabled = true;
+    control_ = enhanced_;  // same start, schedule, loss and seed; no rendering information
+    control_.enhance.enabled = false;
+    YAML::Node search_filled = YAML::Clone(with_data);
+    search_filled["parent"] = model_file("enhance").string();
+    search_ = parse_stage(options_.search, search_command_schema(), search_filled, "search");
+    eval_ = parse_stage(options_.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
+    // The stages that evaluate (prune, eval, heldout) leave latency out: the report stage times
+    // every model side by side, which is the only timing that compares.
+    stage_eval_ = eval_;
+    stage_eval_.latency_runs = 0;
+    YAML::Node prune_filled = YAML::Clone(with_data);
+    prune_filled["model"] = model_file("search").string();
+    prune_filled["eval"] = eval_schema_fields().emit(stage_eval_);
+    prune_ = parse_stage(options_.prune, prune_command_schema(), prune_filled, "prune");
   }
-  const auto exported = stages.run("export", export_config, {trained.hash, enhance.hash, searched.hash, pruned.hash},
-                                   [&](RunDir&, bool) {
-    nlohmann::ordered_json j = nlohmann::ordered_json::array();
-    for (const auto& e : exports) j.push_back(run_export(e));
-    return nlohmann::ordered_json{{"exports", j}};
-  });
-  record("export", exported);
 
-  // eval: classic baselines, the backbone, the control and the CG-enhanced network (prune
-  // evaluated the rest)
-  EvalCommandOptions evaluation;
-  evaluation.seed = options.seed;
-  evaluation.threads = options.threads;
-  evaluation.data = data_path;
-  evaluation.scale = backbone.scale;
-  evaluation.eval = stage_eval;
-  evaluation.models = {"bicubic"};
-  for (const auto& b : options.baselines)
-    if (b != "bicubic") evaluation.models.push_back(b);
-  evaluation.models.push_back(backbone_file.string());
-  evaluation.models.push_back(control_file.string());
-  evaluation.models.push_back(enhanced_file.string());
-  const auto evaluated = stages.run("eval", eval_schema().emit(evaluation),
-                                    {data_hash, trained.hash, controlled.hash, enhance.hash},
-                                    [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
-  record("eval", evaluated);
-
-  // heldout: every model of the run and the classic baselines on scenes it never trained on
-  StageOutcome heldout_stage;
-  if (heldout) {
-    HeldoutJob job;
-    job.models = evaluation.models;
-    job.models.push_back(searched_file.string());
-    for (const auto& b : prune_roles.baselines) job.models.push_back(b.file.string());
-    job.models.push_back(pruned_file.string());
-    job.scale = backbone.scale;
-    job.lr = lr;
-    job.training_scene = data.info().name;
-    job.eval = stage_eval;
-    job.seed = options.seed;
-    job.threads = options.threads;
-    YAML::Node config = heldout_schema().emit(options.heldout);
-    config["models"] = job.models;
-    heldout_stage = stages.run("heldout", config, {trained.hash, controlled.hash, enhance.hash, searched.hash, pruned.hash},
-                               [&](RunDir& dir, bool) { return run_heldout(options.heldout, job, dir.path()); });
-    record("heldout", heldout_stage);
-  }
-  const std::vector<std::string> heldout_runs = heldout_result_files(heldout_stage.summary);
-
-  // report: one table and plot of every model. The stages timed their models minutes or hours
-  // apart, under whatever else the machine was doing then; the report times them again side by
-  // side, in interleaved rounds over the test frames in turn, so that their latencies compare.
-  // Every row's model file by its display name (the static network is read from the hybrid
-  // model's file as a plain model) and its exported ONNX file.
-  std::map<std::string, fs::path> model_files = {{trained.summary.at("name").get<std::string>(), backbone_file},
-                                                 {control.name, control_file},
-                                                 {enhance.summary.at("name").get<std::string>(), enhanced_file},
-                                                 {prune_roles.input.name, searched_file},
-                                                 {prune_roles.hybrid.name, pruned_file},
-                                                 {prune_roles.static_network.name, pruned_file}};
-  for (const auto& b : prune_roles.baselines) model_files[b.name] = b.file;
-  std::map<std::string, fs::path> onnx_files;
-  for (const auto& [name, file] : model_files) {
-    const auto onnx = onnx_of_file.find(file.string());
-    if (onnx != onnx_of_file.end() && name != prune_roles.hybrid.name) onnx_files[name] = onnx->second;
-  }
-  const std::vector<std::string> runs = {(stages.dir("eval") / "results.json").string(),
-                                         (stages.dir("prune") / "results.json").string()};
-  std::vector<std::string> report_runs = runs;
-  report_runs.insert(report_runs.end(), heldout_runs.begin(), heldout_runs.end());
-  const auto reported = stages.run(
-      "report", YAML::Node(report_runs), {evaluated.hash, pruned.hash, exported.hash, heldout_stage.hash},
-      [&](RunDir& dir, bool) {
-        std::vector<EvalResult> evaluations = collect_evaluations(runs);  // timed below; the held-out ones are not
-        if (eval.latency_runs > 0) {
-          std::vector<std::unique_ptr<Upscaler>> upscalers;
-          std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
-          std::vector<Batch> frames;              // per model, the first of them
-          std::vector<std::function<void()>> timed;
-          const std::vector<int> test_frames =
-              data.frames(Split::Test).empty() ? std::vector<int>{0} : data.frames(Split::Test);
-          for (const auto& e : evaluations) {
-            const auto file = model_files.find(e.name);
-            if (e.name == prune_roles.static_network.name)
-              upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(pruned_file).network));
-            else
-              upscalers.push_back(make_upscaler(file == model_files.end() ? e.name : file->second.string(), e.name,
-                                                backbone.scale));
-            sequences.push_back(
-                timing_sequence(data, test_frames, backbone.scale, *upscalers.back(), eval.latency_runs));
-            frames.push_back(sequences.back().frames.front());
-          }
-          for (size_t i = 0; i < upscalers.size(); ++i)
-            timed.push_back([&, i, next = size_t{0}]() mutable {
-              sequences[i].run(*upscalers[i], next++ % sequences[i].size());
-            });
-          spdlog::info("timing {} models side by side ({} interleaved rounds over {} test frames)", timed.size(),
-                       eval.latency_runs, sequences.front().size());
-          const auto latency = measure_latency_interleaved(timed, /*warmup=*/2, eval.latency_runs);
-          for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
-          time_in_onnxruntime(evaluations, onnx_files, frames, eval.latency_runs);
-        }
-        const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
-        evaluations.insert(evaluations.end(), unseen.begin(), unseen.end());
-        return write_report(evaluations, dir, heldout_scenes(heldout_stage.summary));
+  void render() {
+    if (rendering_) {
+      const auto o = stages_.run("render", render_schema().emit(scene_), {}, [&](RunDir& dir, bool) {
+        return run_render(scene_, dir.path());
       });
-  record("report", reported);
-  if (reported.skipped) std::printf("%s", read_file(stages.dir("report") / "report.md").c_str());
-
-  // The run's own rows are those of its data set; the held-out scenes' rows share their names.
-  std::vector<EvalResult> evaluations, unseen;
-  for (auto& e : collect_evaluations({(stages.dir("report") / "results.json").string()}))
-    (e.dataset == data.info().name ? evaluations : unseen).push_back(std::move(e));
-  PipelineResults roles;
-  roles.bicubic = find_result(evaluations, "bicubic");
-  roles.backbone = find_result(evaluations, trained.summary.at("name").get<std::string>());
-  roles.control = find_result(evaluations, control.name);
-  roles.cg_enhanced = find_result(evaluations, enhance.summary.at("name").get<std::string>());
-  roles.cg_optimized = find_result(evaluations, prune_roles.input.name);
-  roles.pruned = find_result(evaluations, prune_roles.hybrid.name);
-  roles.pruned_static = find_result(evaluations, prune_roles.static_network.name);
-  if (const auto* mmp = prune_roles.baseline("magnitude")) roles.magnitude = find_result(evaluations, mmp->name);
-  if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
-    throw Error(root.string(), "the evaluations miss a model of the pipeline (searched: " + prune_roles.input.name + ")",
-                ErrorKind::Internal);
-  for (const auto& scene : heldout_scenes(heldout_stage.summary)) {
-    const auto row = [&](const std::string& name) -> const EvalResult* {
-      for (const auto& e : unseen)
-        if (e.dataset == scene && e.name == name) return &e;
-      return nullptr;
-    };
-    HeldoutScene h{scene, row("bicubic"), {}};
-    for (const EvalResult* n : roles.networks())
-      if (const EvalResult* r = row(n->name)) h.networks.push_back(r);
-    roles.heldout.push_back(std::move(h));
+      record("render", o);
+      data_hash_ = o.hash;
+    } else {
+      data_hash_ = stage_hash(YAML::Node(fs::absolute(options_.data).string()), {});
+    }
+    data_ = std::make_unique<Dataset>(Dataset::open(data_path_));
   }
-  const Verdict verdict = judge_pipeline(roles, options.verdict);
-  write_file_atomic(root / "verdict.txt", verdict.text());
-  results["verdict"] = verdict.to_json();
-  results["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_file_atomic(root / "results.json", results.dump(2) + "\n");
 
-  std::printf("\n%s", verdict.text().c_str());
-  std::printf("report: %s, verdict: %s, run: %s (%.0f s)\n", (stages.dir("report") / "report.md").string().c_str(),
-              (root / "verdict.txt").string().c_str(), root.string().c_str(), results["seconds"].get<double>());
-  if (!verdict.passed() && options.verdict.fail_run)
-    throw Error(root.string(), "the verdict failed " + std::to_string(verdict.failed()) + " check(s) (see verdict.txt)",
-                ErrorKind::Internal);
-  return results;
+  // The plain backbone; the CG-enhanced network (backbone + RIT, + geometry head) trained on from
+  // it with the joint loss; and the control, the backbone trained on as long without the RIT.
+  void train_networks() {
+    const auto train = [&](const std::string& stage, TrainOptions& o, const std::vector<std::string>& upstream) {
+      const auto outcome = stages_.run(stage, train_schema().emit(o), upstream, [&](RunDir& dir, bool resume) {
+        o.resume = resume;
+        return run_train(o, train_schema().emit(o), dir);
+      });
+      record(stage, outcome);
+      return outcome;
+    };
+    trained_ = train("train", backbone_, {data_hash_});
+    enhanced_stage_ = train("enhance", enhanced_, {data_hash_, trained_.hash});
+    control_.name = trained_.summary.at("name").get<std::string>() + " (control)";
+    control_stage_ = train("control", control_, {data_hash_, trained_.hash});
+  }
+
+  // CG-enhanced -> CG-optimized.
+  void search() {
+    searched_ = stages_.run("search", search_command_schema().emit(search_), {data_hash_, enhanced_stage_.hash},
+                            [&](RunDir& dir, bool resume) {
+                              search_.resume = resume;
+                              return run_search_command(search_, search_command_schema().emit(search_), dir);
+                            });
+    record("search", searched_);
+  }
+
+  // Hybrid pruning of the CG-optimized network and its baselines (evaluated with the run's eval options).
+  void prune() {
+    pruned_ = stages_.run("prune", prune_command_schema().emit(prune_), {data_hash_, searched_.hash},
+                          [&](RunDir& dir, bool resume) {
+                            prune_.resume = resume;
+                            return run_prune(prune_, prune_command_schema().emit(prune_), dir);
+                          });
+    record("prune", pruned_);
+    roles_ = prune_roles_from_json(pruned_.summary.at("roles"), (stages_.dir("prune") / "results.json").string());
+  }
+
+  // The CG-optimized and pruned networks go out in every format, verified in the other runtimes;
+  // the others as ONNX only, for the report's ONNX Runtime latency column. Each file is named
+  // after its role; the hybrid model goes out as its deployment directory (a file per pattern,
+  // the selector, the manifest).
+  void export_networks() {
+    const Resolution lr = data_->info().resolutions.front();
+    const fs::path pruned_file = model_file("prune");
+    std::vector<std::pair<fs::path, std::string>> to_export = {
+        {model_file("train"), "backbone"}, {model_file("enhance"), "cg_enhanced"}, {model_file("search"), "cg_optimized"}};
+    for (const auto& b : roles_.baselines) to_export.emplace_back(b.file, b.file.stem().string());
+    to_export.emplace_back(pruned_file, "pruned");
+    std::vector<ExportCommandOptions> exports;
+    YAML::Node export_config(YAML::NodeType::Sequence);
+    for (const auto& [model, stem] : to_export) {
+      const bool deployed = stem == "cg_optimized" || stem == "pruned";
+      for (const auto& format : options_.export_formats) {
+        if (!deployed && format != ExportFormat::Onnx) continue;
+        ExportCommandOptions e;
+        e.seed = options_.seed;
+        e.threads = options_.threads;
+        e.model = model.string();
+        e.format = format;
+        e.input = lr.name();
+        e.verify = true;
+        const bool onnx = format == ExportFormat::Onnx;
+        e.out = (stages_.dir("export") / (model == pruned_file ? stem + (onnx ? "" : "_torchscript")
+                                                               : stem + (onnx ? ".onnx" : ".pt")))
+                    .string();
+        // The hybrid's pattern 0 is its static network.
+        if (onnx)
+          onnx_of_file_[model.string()] =
+              model == pruned_file ? fs::path(e.out) / pattern_file_name(0, format) : fs::path(e.out);
+        exports.push_back(e);
+        export_config.push_back(export_schema().emit(e));
+      }
+    }
+    exported_ = stages_.run("export", export_config, {trained_.hash, enhanced_stage_.hash, searched_.hash, pruned_.hash},
+                            [&](RunDir&, bool) {
+                              nlohmann::ordered_json j = nlohmann::ordered_json::array();
+                              for (const auto& e : exports) j.push_back(run_export(e));
+                              return nlohmann::ordered_json{{"exports", j}};
+                            });
+    record("export", exported_);
+  }
+
+  // The classic baselines, the backbone, the control and the CG-enhanced network (prune
+  // evaluated the rest).
+  void evaluate() {
+    EvalCommandOptions evaluation;
+    evaluation.seed = options_.seed;
+    evaluation.threads = options_.threads;
+    evaluation.data = data_path_;
+    evaluation.scale = backbone_.scale;
+    evaluation.eval = stage_eval_;
+    evaluation.models = classic_models();
+    for (const std::string stage : {"train", "control", "enhance"}) evaluation.models.push_back(model_file(stage).string());
+    evaluated_ = stages_.run("eval", eval_schema().emit(evaluation),
+                             {data_hash_, trained_.hash, control_stage_.hash, enhanced_stage_.hash},
+                             [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
+    record("eval", evaluated_);
+  }
+
+  // Every model of the run and the classic baselines on scenes it never trained on.
+  void evaluate_heldout() {
+    if (options_.heldout.scenes.empty()) return;
+    HeldoutJob job;
+    job.models = classic_models();
+    for (const std::string stage : {"train", "control", "enhance", "search"}) job.models.push_back(model_file(stage).string());
+    for (const auto& b : roles_.baselines) job.models.push_back(b.file.string());
+    job.models.push_back(model_file("prune").string());
+    job.scale = backbone_.scale;
+    job.lr = data_->info().resolutions.front();
+    job.training_scene = data_->info().name;
+    job.eval = stage_eval_;
+    job.seed = options_.seed;
+    job.threads = options_.threads;
+    YAML::Node config = heldout_schema().emit(options_.heldout);
+    config["models"] = job.models;
+    heldout_ = stages_.run(
+        "heldout", config, {trained_.hash, control_stage_.hash, enhanced_stage_.hash, searched_.hash, pruned_.hash},
+        [&](RunDir& dir, bool) { return run_heldout(options_.heldout, job, dir.path()); });
+    record("heldout", heldout_);
+  }
+
+  std::vector<std::string> classic_models() const {
+    std::vector<std::string> models = {"bicubic"};
+    for (const auto& b : options_.baselines)
+      if (b != "bicubic") models.push_back(b);
+    return models;
+  }
+
+  // One table and plot of every model. The stages timed their models minutes or hours apart,
+  // under whatever else the machine was doing then; the report times them again side by side, in
+  // interleaved rounds over the test frames in turn, so that their latencies compare. The
+  // held-out scenes' rows join untimed.
+  void report() {
+    const std::vector<std::string> runs = {(stages_.dir("eval") / "results.json").string(),
+                                           (stages_.dir("prune") / "results.json").string()};
+    const std::vector<std::string> heldout_runs = heldout_result_files(heldout_.summary);
+    std::vector<std::string> report_runs = runs;
+    report_runs.insert(report_runs.end(), heldout_runs.begin(), heldout_runs.end());
+    std::vector<std::string> upstream = {evaluated_.hash, pruned_.hash, exported_.hash};
+    if (!heldout_runs.empty()) upstream.push_back(heldout_.hash);
+    const auto reported = stages_.run(
+        "report", YAML::Node(report_runs), upstream, [&](RunDir& dir, bool) {
+          std::vector<EvalResult> evaluations = collect_evaluations(runs);
+          if (eval_.latency_runs > 0) time_side_by_side(evaluations);
+          const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
+          evaluations.insert(evaluations.end(), unseen.begin(), unseen.end());
+          return write_report(evaluations, dir, heldout_scenes(heldout_.summary));
+        });
+    record("report", reported);
+    if (reported.skipped) std::printf("%s", read_file(stages_.dir("report") / "report.md").c_str());
+  }
+
+  // Every row's model file by its display name (the static network is read from the hybrid
+  // model's file as a plain model).
+  std::map<std::string, fs::path> model_files() const {
+    std::map<std::string, fs::path> files = {{trained_.summary.at("name").get<std::string>(), model_file("train")},
+                                             {control_.name, model_file("control")},
+                                             {enhanced_stage_.summary.at("name").get<std::string>(), model_file("enhance")},
+                                             {roles_.input.name, model_file("search")},
+                                             {roles_.hybrid.name, model_file("prune")},
+                                             {roles_.static_network.name, model_file("prune")}};
+    for (const auto& b : roles_.baselines) files[b.name] = b.file;
+    return files;
+  }
+
+  void time_side_by_side(std::vector<EvalResult>& evaluations) const {
+    const auto files = model_files();
+    std::map<std::string, fs::path> onnx_files;  // each row's exported ONNX file
+    for (const auto& [name, file] : files) {
+      const auto onnx = onnx_of_file_.find(file.string());
+      if (onnx != onnx_of_file_.end() && name != roles_.hybrid.name) onnx_files[name] = onnx->second;
+    }
+    std::vector<std::unique_ptr<Upscaler>> upscalers;
+    std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
+    std::vector<Batch> frames;              // per model, the first of them
+    std::vector<std::function<void()>> timed;
+    const std::vector<int> test_frames =
+        data_->frames(Split::Test).empty() ? std::vector<int>{0} : data_->frames(Split::Test);
+    for (const auto& e : evaluations) {
+      const auto file = files.find(e.name);
+      if (e.name == roles_.static_network.name)
+        upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(model_file("prune")).network));
+      else
+        upscalers.push_back(
+            make_upscaler(file == files.end() ? e.name : file->second.string(), e.name, backbone_.scale));
+      sequences.push_back(timing_sequence(*data_, test_frames, backbone_.scale, *upscalers.back(), eval_.latency_runs));
+      frames.push_back(sequences.back().frames.front());
+    }
+    for (size_t i = 0; i < upscalers.size(); ++i)
+      timed.push_back([&, i, next = size_t{0}]() mutable {
+        sequences[i].run(*upscalers[i], next++ % sequences[i].size());
+      });
+    spdlog::info("timing {} models side by side ({} interleaved rounds over {} test frames)", timed.size(),
+                 eval_.latency_runs, sequences.front().size());
+    const auto latency = measure_latency_interleaved(timed, /*warmup=*/2, eval_.latency_runs);
+    for (size_t i = 0; i < evaluations.size(); ++i) evaluations[i].latency = latency[i];
+    time_in_onnxruntime(evaluations, onnx_files, frames, eval_.latency_runs);
+  }
+
+  // The verdict on the report's rows: the run's own rows are those of its data set (the
+  // held-out scenes' rows share their names).
+  Verdict judge() {
+    for (auto& e : collect_evaluations({(stages_.dir("report") / "results.json").string()}))
+      (e.dataset == data_->info().name ? own_ : unseen_).push_back(std::move(e));
+    PipelineResults roles;
+    roles.bicubic = find_result(own_, "bicubic");
+    roles.backbone = find_result(own_, trained_.summary.at("name").get<std::string>());
+    roles.control = find_result(own_, control_.name);
+    roles.cg_enhanced = find_result(own_, enhanced_stage_.summary.at("name").get<std::string>());
+    roles.cg_optimized = find_result(own_, roles_.input.name);
+    roles.pruned = find_result(own_, roles_.hybrid.name);
+    roles.pruned_static = find_result(own_, roles_.static_network.name);
+    if (const auto* mmp = roles_.baseline("magnitude")) roles.magnitude = find_result(own_, mmp->name);
+    if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
+      throw Error(root_.string(), "the evaluations miss a model of the pipeline (searched: " + roles_.input.name + ")",
+                  ErrorKind::Internal);
+    for (const auto& scene : heldout_scenes(heldout_.summary)) {
+      const auto row = [&](const std::string& name) -> const EvalResult* {
+        for (const auto& e : unseen_)
+          if (e.dataset == scene && e.name == name) return &e;
+        return nullptr;
+      };
+      HeldoutScene h{scene, row("bicubic"), {}};
+      for (const EvalResult* n : roles.networks())
+        if (const EvalResult* r = row(n->name)) h.networks.push_back(r);
+      roles.heldout.push_back(std::move(h));
+    }
+    return judge_pipeline(roles, options_.verdict);
+  }
+
+  const PipelineOptions& options_;
+  fs::path root_;
+  StageRunner stages_;
+  nlohmann::ordered_json results_;
+
+  // Options of every stage, parsed up front.
+  bool rendering_ = false;
+  std::string data_path_;
+  RenderOptions scene_;
+  TrainOptions backbone_, enhanced_, control_;
+  SearchCommandOptions search_;
+  PruneCommandOptions prune_;
+  EvalOptions eval_, stage_eval_;
+
+  // What the stages leave for later ones.
+  std::string data_hash_;
+  std::unique_ptr<Dataset> data_;
+  StageOutcome trained_, enhanced_stage_, control_stage_, searched_, pruned_, exported_, evaluated_, heldout_;
+  PruneRoles roles_;
+  std::map<std::string, fs::path> onnx_of_file_;  // model file -> its exported ONNX file
+  std::vector<EvalResult> own_, unseen_;          // the report's rows: the run's data set, held-out scenes
+};
+
+}  // namespace
+
+nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
+  return Pipeline(options, resolved, root).run();
 }
 
 }  // namespace cgsr::cli
