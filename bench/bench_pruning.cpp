@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   TimingSequence sequence;
   for (int f : frames) {
     sequence.frames.push_back(frame_batch(data, f, scale, hybrid.channels(), hybrid.depth_encoding()));
-    sequence.previous.push_back(frame_batch(data, std::max(0, f - 1), scale, hybrid.channels(), hybrid.depth_encoding()));
+    sequence.previous.push_back(frame_batch(data, data.has_previous(f) ? f - 1 : f, scale, hybrid.channels(), hybrid.depth_encoding()));
   }
   const std::vector<Batch>& batches = sequence.frames;
   PatternNetworks patterns(*model.network, model.pool);

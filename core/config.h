@@ -300,6 +300,14 @@ class Schema {
     fields_.push_back(std::move(f));
   }
 
+  // Leaves `key` out of emit() while `omit` holds: keys that do not apply (e.g. a single scene's
+  // keys in a scene set), and optional keys added later, which keep older configs' resolved form
+  // (and the hashes made of it) unchanged while unset.
+  void omit_when(const std::string& key, std::function<bool(const T&)> omit) {
+    for (auto& f : fields_)
+      if (f.key == key) f.omit = omit;
+  }
+
   // A check across fields, run after all fields are parsed (e.g. "hr size = scale x lr size").
   void validate(std::function<void(const T&, const Cursor&, const YAML::Node&)> check) {
     cross_checks_.push_back(std::move(check));
@@ -334,7 +342,8 @@ class Schema {
 
   YAML::Node emit(const T& value) const {
     YAML::Node n(YAML::NodeType::Map);
-    for (const auto& f : fields_) n[f.key] = f.emit(value);
+    for (const auto& f : fields_)
+      if (!f.omit || !f.omit(value)) n[f.key] = f.emit(value);
     return n;
   }
 
@@ -355,6 +364,7 @@ class Schema {
   struct Field {
     std::string key, doc;
     bool required = false;
+    std::function<bool(const T&)> omit;
     std::function<void(const YAML::Node&, T&, const Cursor&)> parse;
     std::function<YAML::Node(const T&)> emit;
     std::function<const void*(const T&)> member;

@@ -114,7 +114,7 @@ torch::Tensor DynamicPruning::sampler_input(int frame) {
   const DepthEncoding depth = network_->depth_encoding();
   const auto info = frame_batch(data_, frame, scale, channels_, depth).lr_info;
   torch::Tensor previous;
-  if (frame > 0) previous = frame_batch(data_, frame - 1, scale, channels_, depth).lr_info;
+  if (data_.has_previous(frame)) previous = frame_batch(data_, frame - 1, scale, channels_, depth).lr_info;
   const auto input = cgsr::sampler_input(info, previous, channels_, samplers_->options().grid);
   return inputs_.emplace(frame, input).first->second;
 }

@@ -169,7 +169,19 @@ DataCheckReport check_dataset(const fs::path& path, const DatasetOpenOptions& op
     info.resolutions = m.resolutions;
     info.split = m.split;
     check_structure(info, c);
-    check_cgsr_files(path, m, c);
+    for (const auto& sc : m.scenes) report.scenes.push_back(sc.name + " (" + std::to_string(sc.frames) + " frames)");
+    if (m.scenes.empty()) check_cgsr_files(path, m, c);
+    for (const auto& sc : m.scenes) {
+      // Scene by scene, so one missing or changed scene does not hide the others' files.
+      DatasetManifest one = m;
+      one.scenes = {sc};
+      try {
+        const ScenePart part = scene_parts(path, one).front();
+        check_cgsr_files(part.root, part.manifest, c);
+      } catch (const Error& e) {
+        c.problem("scene", e.what());
+      }
+    }
   } else {
     const Dataset data = Dataset::open(path, options);
     const auto& info = data.info();

@@ -20,6 +20,7 @@ struct DataCheckReport {
   std::vector<Resolution> resolutions;
   std::vector<std::string> channels;   // channels checked
   std::vector<std::string> derived;    // of which derived (other layouts)
+  std::vector<std::string> scenes;     // of a multi-scene data set: "name (N frames)"
   int64_t frames_checked = 0;          // (frame, resolution) pairs
   int64_t files_checked = 0;
   std::map<std::string, int64_t> problems;  // problem kind -> count ("missing", "NaN/Inf", ...)

@@ -81,33 +81,49 @@ const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t re
 // ---- our own format -----------------------------------------------------------------------------
 
 namespace {
+// A single-scene data set, or a multi-scene one whose frames are read from its scenes' data sets.
 class CgsrDataset : public FrameSource {
  public:
-  CgsrDataset(const fs::path& root, const DatasetOpenOptions&) : root_(root), manifest_(read_manifest(root)) {
+  CgsrDataset(const fs::path& root, const DatasetOpenOptions&) : manifest_(read_manifest(root)) {
     if (!manifest_.complete)
       throw Error((root / "manifest.yaml").string(),
                   "the render is incomplete (complete: false); rerun the same `cgsr render` command to finish it");
+    parts_ = scene_parts(root, manifest_);
+    const DatasetManifest& first = parts_.front().manifest;
     info_.name = manifest_.name;
     info_.layout = "cgsr";
     info_.root = root;
     info_.frames = manifest_.frames;
     info_.resolutions = manifest_.resolutions;
-    info_.near_plane = manifest_.near_plane;
-    info_.far_plane = manifest_.far_plane;
-    info_.vfov = manifest_.vfov;
+    info_.near_plane = first.near_plane;
+    info_.far_plane = first.far_plane;
+    info_.vfov = first.vfov;
     info_.stored = all_render_channels();
     info_.split = manifest_.split;
+    for (const auto& p : parts_)
+      info_.scenes.push_back({p.name, p.first_frame, p.manifest.frames, p.manifest.near_plane, p.manifest.far_plane,
+                              p.manifest.vfov, p.weight});
   }
   const DatasetInfo& info() const override { return info_; }
   Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {
-    return read_dataset_frame(root_, manifest_, frame, res, channels);
+    for (const auto& p : parts_)
+      if (frame >= p.first_frame && frame < p.first_frame + p.manifest.frames)
+        return read_dataset_frame(p.root, p.manifest, frame - p.first_frame, res, channels);
+    throw Error(info_.root.string(), "frame " + std::to_string(frame) + " out of range", ErrorKind::Internal);
   }
 
  private:
-  fs::path root_;
   DatasetManifest manifest_;
+  std::vector<ScenePart> parts_;
   DatasetInfo info_;
 };
+
+const SceneInfo& find_scene(const DatasetInfo& info, int frame) {
+  for (const auto& s : info.scenes)
+    if (s.contains(frame)) return s;
+  throw Error(info.root.string(), "frame " + std::to_string(frame) + " out of range (" + std::to_string(info.frames) +
+                                      " frames)");
+}
 }  // namespace
 
 std::unique_ptr<FrameSource> open_cgsr_dataset(const fs::path& root, const DatasetOpenOptions& options) {
@@ -160,7 +176,7 @@ struct Dataset::Impl {
     Frame f = source->load(index, res, here);
     if (!info.derived.empty() && f.depth.defined()) {
       try {
-        derive_channels(f, info.derived, info.vfov, options.edges);
+        derive_channels(f, info.derived, find_scene(info, index).vfov, options.edges);
       } catch (const Error& e) {
         throw Error(info.root.string(), "frame " + std::to_string(index) + ": " + e.message(), e.kind());
       }
@@ -192,6 +208,9 @@ Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
   Impl& impl = *d.impl_;
   impl.source = loaders.get(layout).open(path, options);
   impl.info = impl.source->info();
+  if (impl.info.scenes.empty())
+    impl.info.scenes.push_back({impl.info.name, 0, impl.info.frames, impl.info.near_plane, impl.info.far_plane,
+                                impl.info.vfov, 0});
   impl.options = options;
   resolve_channels(impl.info, options);
   for (auto c : impl.info.channels)
@@ -205,7 +224,7 @@ Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
   return d;
 }
 
-const DatasetInfo& Dataset::info() const { return impl_->info; }
+const DatasetInfo& Dataset::info() const { return view_ ? *view_ : impl_->info; }
 int Dataset::frame_count() const { return impl_->info.frames; }
 const std::vector<Resolution>& Dataset::resolutions() const { return impl_->info.resolutions; }
 
@@ -219,10 +238,36 @@ size_t Dataset::resolution_index(const Resolution& r) const {
 }
 
 std::vector<int> Dataset::frames(Split split) const {
-  if (split != Split::All) return impl_->info.split.of(split);
-  std::vector<int> all(impl_->info.frames);
-  for (int i = 0; i < impl_->info.frames; ++i) all[i] = i;
+  if (split != Split::All) return info().split.of(split);
+  std::vector<int> all;
+  for (const auto& s : info().scenes)
+    for (int i = 0; i < s.frames; ++i) all.push_back(s.first_frame + i);
   return all;
+}
+
+const std::vector<SceneInfo>& Dataset::scenes() const { return info().scenes; }
+const SceneInfo& Dataset::scene_of(int frame) const { return find_scene(impl_->info, frame); }
+bool Dataset::has_previous(int frame) const { return frame > scene_of(frame).first_frame; }
+
+Dataset Dataset::scene(const std::string& name) const {
+  std::vector<std::string> names;
+  for (const auto& s : info().scenes) {
+    if (s.name != name) {
+      names.push_back(s.name);
+      continue;
+    }
+    auto view = std::make_shared<DatasetInfo>(info());
+    if (view->scenes.size() > 1) view->name += "/" + name;
+    view->scenes = {s};
+    for (Split split : {Split::Train, Split::Val, Split::Test}) {
+      auto& list = const_cast<std::vector<int>&>(view->split.of(split));
+      list.erase(std::remove_if(list.begin(), list.end(), [&](int f) { return !s.contains(f); }), list.end());
+    }
+    Dataset d = *this;
+    d.view_ = std::move(view);
+    return d;
+  }
+  throw Error(info().root.string(), "has no scene '" + name + "'" + did_you_mean(name, names) + " (scenes: " + join(names) + ")");
 }
 
 std::vector<int> spread_frames(const std::vector<int>& frames, int count) {

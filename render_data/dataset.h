@@ -41,6 +41,16 @@ struct DatasetOpenOptions {
 
 config::Schema<DatasetOpenOptions> dataset_open_schema();
 
+// A scene of a data set: a run of consecutive frames rendered from one scene and camera path.
+// Every data set has at least one; a multi-scene cgsr data set (dataset_manifest.h) has several.
+struct SceneInfo {
+  std::string name;
+  int first_frame = 0, frames = 0;
+  double near_plane = 0.05, far_plane = 500, vfov = 60;  // the depth planes and FOV of its frames
+  double weight = 0;  // sampling weight; 0 for every scene: proportional to its training frames
+  bool contains(int frame) const { return frame >= first_frame && frame < first_frame + frames; }
+};
+
 struct DatasetInfo {
   std::string name, layout;
   std::filesystem::path root;
@@ -54,6 +64,9 @@ struct DatasetInfo {
   // its frames carry after loading and derivation (a capture may have depth only at LR).
   std::vector<std::vector<RenderChannel>> stored_at, channels_at;
   FrameSplit split;
+  // In frame order, covering the frames (of a one-scene view: that scene's frames). Loaders
+  // without scenes leave it empty and get one scene of every frame named after the data set.
+  std::vector<SceneInfo> scenes;
   std::vector<std::string> notes;       // e.g. "tile-grid lines removed from edges"
 };
 
@@ -83,7 +96,16 @@ class Dataset {
   int frame_count() const;
   const std::vector<Resolution>& resolutions() const;
   size_t resolution_index(const Resolution& r) const;  // cgsr::Error listing the resolutions
-  std::vector<int> frames(Split split) const;           // Split::All: 0 .. N-1
+  std::vector<int> frames(Split split) const;           // Split::All: 0 .. N-1 (a view: its scene's)
+
+  const std::vector<SceneInfo>& scenes() const;
+  const SceneInfo& scene_of(int frame) const;           // cgsr::Error when out of range
+  // Whether `frame` has a predecessor in its own scene (the previous frame of a sequence: motion
+  // vectors, temporal error and stateful upscalers read it; a scene's first frame has none).
+  bool has_previous(int frame) const;
+  // A view of one scene (by name; cgsr::Error listing the names): frame indices stay the set's,
+  // frames() and the split hold that scene's only; frames are shared with this data set's cache.
+  Dataset scene(const std::string& name) const;
 
   // Cached; safe to call from several threads.
   std::shared_ptr<const Frame> frame(int index, size_t resolution) const;
@@ -95,6 +117,7 @@ class Dataset {
  private:
   struct Impl;
   std::shared_ptr<Impl> impl_;
+  std::shared_ptr<const DatasetInfo> view_;  // a one-scene view's info; null: the whole set
 };
 
 // At most `count` frames spread evenly over `frames`, in order (count <= 0: all of them).

@@ -105,11 +105,33 @@ fs::path DatasetManifest::file(const fs::path& root, int frame, size_t resolutio
 
 bool has_manifest(const fs::path& root) { return fs::exists(root / "manifest.yaml"); }
 
+std::string hex_fingerprint(const std::string& text) {
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a 64
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  char buf[20];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+namespace {
+void write_split(YAML::Emitter& out, const FrameSplit& split) {
+  out << YAML::Key << "split" << YAML::Value << YAML::BeginMap;
+  for (Split s : {Split::Train, Split::Val, Split::Test}) {
+    out << YAML::Key << split_name(s) << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int f : split.of(s)) out << f;
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+}
+}  // namespace
+
 void write_manifest(const fs::path& root, const DatasetManifest& m) {
+  const bool multi = !m.scenes.empty();
   YAML::Emitter out;
   out << YAML::BeginMap;
   out << YAML::Key << "format" << YAML::Value << DatasetManifest::kFormat;
-  out << YAML::Key << "version" << YAML::Value << DatasetManifest::kVersion;
+  // A single scene stays version 1, readable by builds that predate scenes.
+  out << YAML::Key << "version" << YAML::Value << (multi ? DatasetManifest::kVersion : DatasetManifest::kSingleSceneVersion);
   out << YAML::Key << "name" << YAML::Value << m.name;
   out << YAML::Key << "complete" << YAML::Value << m.complete;
   out << YAML::Key << "fingerprint" << YAML::Value << m.fingerprint;
@@ -117,6 +139,24 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
   out << YAML::Key << "resolutions" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const auto& r : m.resolutions) out << r.name();
   out << YAML::EndSeq;
+  if (multi) {
+    out << YAML::Key << "scenes" << YAML::Value << YAML::BeginSeq;
+    for (const auto& sc : m.scenes) {
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << sc.name;
+      out << YAML::Key << "path" << YAML::Value << sc.path;
+      out << YAML::Key << "first_frame" << YAML::Value << sc.first_frame;
+      out << YAML::Key << "frames" << YAML::Value << sc.frames;
+      if (sc.weight > 0) out << YAML::Key << "weight" << YAML::Value << sc.weight;
+      out << YAML::Key << "fingerprint" << YAML::Value << sc.fingerprint;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+    write_split(out, m.split);
+    out << YAML::EndMap;
+    write_file_atomic(root / "manifest.yaml", std::string(out.c_str()) + "\n");
+    return;
+  }
   out << YAML::Key << "near" << YAML::Value << m.near_plane;
   out << YAML::Key << "far" << YAML::Value << m.far_plane;
   out << YAML::Key << "vfov" << YAML::Value << m.vfov;
@@ -130,13 +170,7 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
     out << YAML::EndMap;
   }
   out << YAML::EndMap;
-  out << YAML::Key << "split" << YAML::Value << YAML::BeginMap;
-  for (Split s : {Split::Train, Split::Val, Split::Test}) {
-    out << YAML::Key << split_name(s) << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (int f : m.split.of(s)) out << f;
-    out << YAML::EndSeq;
-  }
-  out << YAML::EndMap;
+  write_split(out, m.split);
   if (!m.bytes_per_frame.empty()) {
     out << YAML::Key << "bytes_per_frame" << YAML::Value << YAML::BeginMap;
     for (size_t i = 0; i < m.resolutions.size() && i < m.bytes_per_frame.size(); ++i)
@@ -146,6 +180,45 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
   out << YAML::EndMap;
   write_file_atomic(root / "manifest.yaml", std::string(out.c_str()) + "\n");
 }
+
+namespace {
+void read_scenes(const YAML::Node& list, const config::Cursor& at, DatasetManifest& m) {
+  if (!list.IsSequence() || list.size() == 0)
+    at.fail(list, "expected a non-empty list of scenes, got " + config::detail::describe(list));
+  int next = 0;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node e = list[i];
+    const config::Cursor eat = at.index(i);
+    if (!e.IsMap()) eat.fail(e, "expected a map {name, path, first_frame, frames, fingerprint}, got " + config::detail::describe(e));
+    auto need = [&](const char* key) {
+      if (!e[key]) eat.child(key).fail(e, std::string("missing required key '") + key + "'");
+      return e[key];
+    };
+    ManifestScene sc;
+    sc.name = config::Codec<std::string>::decode(need("name"), eat.child("name"));
+    sc.path = config::Codec<std::string>::decode(need("path"), eat.child("path"));
+    sc.fingerprint = config::Codec<std::string>::decode(need("fingerprint"), eat.child("fingerprint"));
+    sc.first_frame = config::Codec<int>::decode(need("first_frame"), eat.child("first_frame"));
+    sc.frames = config::Codec<int>::decode(need("frames"), eat.child("frames"));
+    if (e["weight"]) sc.weight = config::Codec<double>::decode(e["weight"], eat.child("weight"));
+    if (sc.name.empty()) eat.child("name").fail(e["name"], "must not be empty");
+    if (sc.path.empty()) eat.child("path").fail(e["path"], "must not be empty");
+    if (sc.frames < 1) eat.child("frames").fail(e["frames"], "must be at least 1");
+    if (sc.first_frame != next)
+      eat.child("first_frame").fail(e["first_frame"], "must be " + std::to_string(next) + " (the frames of the scenes before)");
+    if (sc.weight < 0) eat.child("weight").fail(e["weight"], "must be at least 0");
+    for (const auto& other : m.scenes)
+      if (other.name == sc.name) eat.child("name").fail(e["name"], "scene '" + sc.name + "' is listed twice");
+    next += sc.frames;
+    m.scenes.push_back(sc);
+  }
+  if (next != m.frames)
+    at.fail(list, "the scenes have " + std::to_string(next) + " frames, the manifest says " + std::to_string(m.frames));
+  const auto weighted = std::count_if(m.scenes.begin(), m.scenes.end(), [](const ManifestScene& s) { return s.weight > 0; });
+  if (weighted != 0 && weighted != static_cast<long>(m.scenes.size()))
+    at.fail(list, "give every scene a weight, or none (then scenes are drawn in proportion to their training frames)");
+}
+}  // namespace
 
 DatasetManifest read_manifest(const fs::path& root) {
   const fs::path path = root / "manifest.yaml";
@@ -162,7 +235,9 @@ DatasetManifest read_manifest(const fs::path& root) {
   const auto format = config::Codec<std::string>::decode(need("format"), at.child("format"));
   if (format != DatasetManifest::kFormat) at.child("format").fail(n["format"], "expected '" + std::string(DatasetManifest::kFormat) + "'");
   const int version = config::Codec<int>::decode(need("version"), at.child("version"));
-  if (version != DatasetManifest::kVersion) at.child("version").fail(n["version"], "unsupported version " + std::to_string(version));
+  if (version < DatasetManifest::kSingleSceneVersion || version > DatasetManifest::kVersion)
+    at.child("version").fail(n["version"], "unsupported version " + std::to_string(version) + " (this build reads 1 to " +
+                                               std::to_string(DatasetManifest::kVersion) + ")");
   m.name = config::Codec<std::string>::decode(need("name"), at.child("name"));
   m.complete = config::Codec<bool>::decode(need("complete"), at.child("complete"));
   m.fingerprint = config::Codec<std::string>::decode(need("fingerprint"), at.child("fingerprint"));
@@ -171,9 +246,15 @@ DatasetManifest read_manifest(const fs::path& root) {
   for (const auto& r : config::Codec<std::vector<std::string>>::decode(need("resolutions"), at.child("resolutions")))
     m.resolutions.push_back(parse_resolution(r, doc.locate(n["resolutions"]) + ": resolutions"));
   if (m.resolutions.empty()) at.child("resolutions").fail(n["resolutions"], "needs at least one resolution");
-  m.near_plane = config::Codec<double>::decode(need("near"), at.child("near"));
-  m.far_plane = config::Codec<double>::decode(need("far"), at.child("far"));
-  if (!(m.near_plane > 0) || !(m.far_plane > m.near_plane)) at.child("far").fail(n["far"], "need 0 < near < far");
+  if (const YAML::Node scenes = n["scenes"]) {
+    if (version < 2) at.child("scenes").fail(scenes, "scenes need manifest version 2");
+    read_scenes(scenes, at.child("scenes"), m);
+  } else {
+    // A multi-scene set has the planes per scene (in the scenes' manifests).
+    m.near_plane = config::Codec<double>::decode(need("near"), at.child("near"));
+    m.far_plane = config::Codec<double>::decode(need("far"), at.child("far"));
+    if (!(m.near_plane > 0) || !(m.far_plane > m.near_plane)) at.child("far").fail(n["far"], "need 0 < near < far");
+  }
   if (n["vfov"]) m.vfov = config::Codec<double>::decode(n["vfov"], at.child("vfov"));
   if (n["scene_source"]) m.scene_source = config::Codec<std::string>::decode(n["scene_source"], at.child("scene_source"));
   if (n["seed"]) m.seed = config::Codec<uint64_t>::decode(n["seed"], at.child("seed"));
@@ -197,6 +278,118 @@ DatasetManifest read_manifest(const fs::path& root) {
   for (size_t i = 1; i < m.resolutions.size(); ++i)
     if (m.resolutions[i].width <= m.resolutions[i - 1].width)
       at.child("resolutions").fail(n["resolutions"], "resolutions must be listed in ascending order");
+  return m;
+}
+
+DatasetManifest scene_set_manifest(const std::string& name, const std::vector<Resolution>& resolutions,
+                                   std::vector<ManifestScene> scenes, const std::vector<FrameSplit>& splits) {
+  if (scenes.empty()) throw Error("scenes", "a multi-scene data set needs at least one scene");
+  if (splits.size() != scenes.size()) throw Error("scenes", "one split per scene", ErrorKind::Internal);
+  DatasetManifest m;
+  m.name = name;
+  m.resolutions = resolutions;
+  std::string text;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    ManifestScene& sc = scenes[i];
+    for (size_t j = 0; j < i; ++j)
+      if (scenes[j].name == sc.name)
+        throw Error("scenes", "two scenes are named '" + sc.name + "' (" + scenes[j].path + " and " + sc.path +
+                                  "); scene names must be unique");
+    sc.first_frame = m.frames;
+    for (Split s : {Split::Train, Split::Val, Split::Test}) {
+      auto& into = const_cast<std::vector<int>&>(m.split.of(s));
+      for (int f : splits[i].of(s)) into.push_back(sc.first_frame + f);
+    }
+    if (sc.weight < 0) throw Error(sc.path, "scene '" + sc.name + "': weight must be at least 0");
+    if ((sc.weight > 0) != (scenes[0].weight > 0))
+      throw Error(sc.path, "scene '" + sc.name + "': give every scene a weight, or none (then scenes are drawn in "
+                           "proportion to their training frames)");
+    m.frames += sc.frames;
+    text += sc.name + "|" + sc.fingerprint + "|" + std::to_string(sc.frames) + "|";
+  }
+  for (const auto& r : resolutions) text += r.name() + "|";
+  m.fingerprint = hex_fingerprint(text);
+  m.scenes = std::move(scenes);
+  return m;
+}
+
+fs::path scene_root(const fs::path& root, const ManifestScene& scene) {
+  const fs::path p(scene.path);
+  return p.is_absolute() ? p : root / p;
+}
+
+std::vector<ScenePart> scene_parts(const fs::path& root, const DatasetManifest& m) {
+  if (m.scenes.empty()) return {ScenePart{m.name, root, m, 0, 0}};
+  const std::string where = (root / "manifest.yaml").string();
+  std::vector<ScenePart> parts;
+  for (const auto& sc : m.scenes) {
+    const fs::path dir = scene_root(root, sc);
+    const std::string what = "scene '" + sc.name + "' (" + dir.string() + ")";
+    if (!has_manifest(dir)) throw Error(where, what + ": no data set there (no manifest.yaml)");
+    ScenePart part{sc.name, dir, read_manifest(dir), sc.first_frame, sc.weight};
+    const DatasetManifest& s = part.manifest;
+    if (!s.scenes.empty()) throw Error(where, what + ": is itself a multi-scene data set; list its scenes instead");
+    if (!s.complete) throw Error(where, what + ": the render is incomplete (complete: false)");
+    if (s.fingerprint != sc.fingerprint || s.frames != sc.frames)
+      throw Error(where, what + ": changed since this set was written (fingerprint " + s.fingerprint + " and " +
+                             std::to_string(s.frames) + " frames, recorded " + sc.fingerprint + " and " +
+                             std::to_string(sc.frames) + "); write the set again (cgsr render / cgsr data merge)");
+    if (s.resolutions != m.resolutions) {
+      std::vector<std::string> have, want;
+      for (const auto& r : s.resolutions) have.push_back(r.name());
+      for (const auto& r : m.resolutions) want.push_back(r.name());
+      throw Error(where, what + ": has resolutions " + join(have) + ", the set " + join(want));
+    }
+    parts.push_back(std::move(part));
+  }
+  return parts;
+}
+
+DatasetManifest merge_manifests(const fs::path& out, const std::string& name, const std::vector<fs::path>& data,
+                                const std::vector<double>& weights) {
+  if (data.empty()) throw Error("data", "give the data sets to merge");
+  if (!weights.empty() && weights.size() != data.size())
+    throw Error("weights", "give one weight per data set (" + std::to_string(data.size()) + "), got " +
+                               std::to_string(weights.size()));
+  const fs::path target = fs::weakly_canonical(fs::absolute(out));
+  if (has_manifest(out) && read_manifest(out).scenes.empty())
+    throw Error(out.string(), "holds a rendered data set; write the merged one into another directory");
+  // Relative to the set where the two share a root, so the pair can be moved together.
+  const auto reference = [&](const fs::path& dir) {
+    const fs::path full = fs::weakly_canonical(fs::absolute(dir));
+    const fs::path rel = full.lexically_relative(target);
+    return rel.empty() ? full.string() : rel.string();
+  };
+  std::vector<ManifestScene> scenes;
+  std::vector<FrameSplit> splits;
+  std::vector<std::string> names;
+  std::vector<Resolution> resolutions;
+  for (size_t i = 0; i < data.size(); ++i) {
+    const fs::path& dir = data[i];
+    if (fs::weakly_canonical(fs::absolute(dir)) == target)
+      throw Error(dir.string(), "is the output directory; write the merged data set into a directory of its own");
+    const DatasetManifest m = read_manifest(dir);
+    if (!m.complete) throw Error((dir / "manifest.yaml").string(), "the render is incomplete (complete: false)");
+    if (i == 0) resolutions = m.resolutions;
+    if (m.resolutions != resolutions) {
+      std::vector<std::string> have, want;
+      for (const auto& r : m.resolutions) have.push_back(r.name());
+      for (const auto& r : resolutions) want.push_back(r.name());
+      throw Error(dir.string(), "has resolutions " + join(have) + ", but " + data[0].string() + " has " + join(want) +
+                                    ": merged data sets need the same resolutions (and so the same scales)");
+    }
+    if (!weights.empty() && !m.scenes.empty())
+      throw Error(dir.string(), "is a multi-scene data set: weights are per single-scene data set (its scenes keep "
+                                "none; merge its scenes' directories to weight them)");
+    for (const ScenePart& part : scene_parts(dir, m)) {
+      const double weight = weights.empty() ? 0 : weights[i];
+      scenes.push_back({part.name, reference(part.root), part.manifest.fingerprint, 0, part.manifest.frames, weight});
+      splits.push_back(part.manifest.split);
+      names.push_back(part.name);
+    }
+  }
+  DatasetManifest m = scene_set_manifest(name.empty() ? join(names, "+") : name, resolutions, scenes, splits);
+  m.complete = true;
   return m;
 }
 

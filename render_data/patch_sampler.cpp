@@ -4,6 +4,7 @@
 #include <oneapi/tbb/task_group.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <deque>
 
 #include "core/error.h"
@@ -118,6 +119,24 @@ PatchSampler::PatchSampler(Dataset data, PatchSamplerOptions options)
   require_channels(data_, o.channels, lr_, hr_);
   frames_ = data_.frames(o.split);
   if (frames_.empty()) throw Error(data_.info().root.string(), "the " + split_name(o.split) + " split has no frames");
+  // Weighted scenes: the split's frames per scene, and each scene's share of the draws. Without
+  // weights a frame is drawn uniformly from the split, which is each scene in proportion to its
+  // frames there (and the draw sequence of a single-scene data set).
+  const auto& scenes = data_.scenes();
+  if (std::any_of(scenes.begin(), scenes.end(), [](const SceneInfo& s) { return s.weight > 0; })) {
+    double total = 0;
+    for (const auto& s : scenes) {
+      std::vector<int> mine;
+      for (int f : frames_)
+        if (s.contains(f)) mine.push_back(f);
+      if (mine.empty()) continue;  // a scene with no frame in this split (too short to have one)
+      total += s.weight;
+      scene_frames_.push_back(std::move(mine));
+      scene_cumulative_.push_back(total);
+    }
+    for (double& c : scene_cumulative_) c /= total;
+    scene_cumulative_.back() = 1.0;
+  }
 }
 
 PatchSampler::~PatchSampler() = default;
@@ -125,7 +144,6 @@ PatchSampler::~PatchSampler() = default;
 Batch PatchSampler::build(int64_t k) const {
   const auto& o = options_;
   const Resolution lr = data_.resolutions()[lr_];
-  const auto& info = data_.info();
   // Draw every item's choices first from one stream: the batch depends only on (seed, k).
   struct Choice {
     int frame, x, y, aug;
@@ -133,7 +151,14 @@ Batch PatchSampler::build(int64_t k) const {
   std::vector<Choice> choices(o.batch_size);
   auto rng = make_rng("patch-sampler", o.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(k));
   for (auto& c : choices) {
-    c.frame = frames_[rng() % frames_.size()];
+    if (scene_frames_.empty()) {
+      c.frame = frames_[rng() % frames_.size()];
+    } else {
+      const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;  // [0, 1)
+      const size_t s = std::upper_bound(scene_cumulative_.begin(), scene_cumulative_.end(), u) - scene_cumulative_.begin();
+      const auto& mine = scene_frames_[std::min(s, scene_frames_.size() - 1)];
+      c.frame = mine[rng() % mine.size()];
+    }
     c.x = static_cast<int>(rng() % static_cast<uint64_t>(lr.width - o.patch_size + 1));
     c.y = static_cast<int>(rng() % static_cast<uint64_t>(lr.height - o.patch_size + 1));
     c.aug = o.augment ? static_cast<int>(rng() % 8) : 0;
@@ -143,8 +168,9 @@ Batch PatchSampler::build(int64_t k) const {
     const Choice& c = choices[i];
     const auto l = data_.frame(c.frame, lr_), h = data_.frame(c.frame, hr_);
     const Augmentation aug = Augmentation::from_index(c.aug);
+    const SceneInfo& scene = data_.scene_of(c.frame);  // depth is encoded with its scene's planes
     items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
-                         info.near_plane, info.far_plane, o.augment ? &aug : nullptr);
+                         scene.near_plane, scene.far_plane, o.augment ? &aug : nullptr);
   });
   std::vector<int> frames;
   for (const auto& c : choices) frames.push_back(c.frame);
@@ -187,9 +213,9 @@ Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<R
   const auto [lo, hi] = resolution_pair(data, scale, lr_width);
   require_channels(data, channels, lo, hi);
   const auto l = data.frame(frame, lo), h = data.frame(frame, hi);
-  const auto& info = data.info();
-  std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, depth, info.near_plane,
-                                    info.far_plane, nullptr)};
+  const SceneInfo& scene = data.scene_of(frame);
+  std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, depth, scene.near_plane,
+                                    scene.far_plane, nullptr)};
   return stack(items, channels, depth, {frame}, scale);
 }
 

@@ -12,7 +12,9 @@
 //   for (int k = 0; k < frames.size(); ++k) { Batch b = frames.get(k); ... }   // N = 1, full frames
 //   Batch f = frame_batch(data, /*frame=*/12, /*scale=*/2, channels, DepthEncoding::Log);  // any frame
 //
-// Patches: a random frame of the split, a random LR window, the HR window exactly `scale` times
+// Patches: a random frame of the split (of a multi-scene data set with scene weights: a scene
+// drawn by weight, then one of its frames; without: each scene in proportion to its frames in
+// the split), a random LR window, the HR window exactly `scale` times
 // it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), DESIGN.md). With
 // augment, each item gets one of the 8 flips/rotations, applied to every tensor; normals and
 // motion vectors are rotated/flipped as vectors (augment.h). Batch k depends only on the seed
@@ -64,6 +66,10 @@ class PatchSampler {
   PatchSamplerOptions options_;
   size_t lr_, hr_;
   std::vector<int> frames_;
+  // Data sets with scene weights: the split's frames of each scene that has some, and the
+  // cumulative share of the draws up to each (the last is 1). Empty: uniform over frames_.
+  std::vector<std::vector<int>> scene_frames_;
+  std::vector<double> scene_cumulative_;
   int64_t next_ = 0;
   std::unique_ptr<Prefetch> prefetch_;
 };

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 
@@ -48,18 +49,23 @@ std::string human_bytes(double bytes) {
   return buf;
 }
 
-namespace {
-std::string fingerprint(const RenderJobOptions& o, uint64_t seed) {
+std::string render_fingerprint(const RenderJobOptions& o, uint64_t seed) {
   std::string text = config::to_yaml(o.scene.node) + "|" + std::to_string(o.frames) + "|" + std::to_string(seed) + "|" +
                      std::to_string(o.shadows) + "|" + std::to_string(o.shadow_map_size) + "|" +
                      std::to_string(o.edges.depth_threshold) + "|" + std::to_string(o.edges.crease_angle) + "|" +
                      std::to_string(o.edges.id_changes);
   for (const auto& r : o.resolutions) text += "|" + r;
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
-  char buf[20];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return hex_fingerprint(text);
+}
+
+namespace {
+// A killed render resumes; a directory with a render of something else is left alone.
+void check_resumable(const fs::path& out, const std::string& fingerprint) {
+  if (!has_manifest(out)) return;
+  const DatasetManifest previous = read_manifest(out);
+  if (previous.fingerprint != fingerprint)
+    throw Error(out.string(), "holds a render of a different configuration (manifest fingerprint " + previous.fingerprint +
+                                  ", this config " + fingerprint + "); render into another --out directory");
 }
 }  // namespace
 
@@ -72,7 +78,7 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   RenderJobResult result;
   DatasetManifest& m = result.manifest;
   m.name = o.name.empty() ? bundle.scene.name : o.name;
-  m.fingerprint = fingerprint(o, seed);
+  m.fingerprint = render_fingerprint(o, seed);
   m.frames = o.frames;
   m.resolutions = resolutions;
   m.near_plane = bundle.camera.near_plane;
@@ -83,13 +89,7 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   m.split = make_split(o.frames);
 
   fs::create_directories(out);
-  if (has_manifest(out)) {
-    const DatasetManifest previous = read_manifest(out);
-    if (previous.fingerprint != m.fingerprint)
-      throw Error(out.string(), "holds a render of a different configuration (manifest fingerprint " +
-                                    previous.fingerprint + ", this config " + m.fingerprint +
-                                    "); render into another --out directory");
-  }
+  check_resumable(out, m.fingerprint);
   write_manifest(out, m);  // complete: false until every frame is written
 
   RenderSettings settings;
@@ -135,6 +135,61 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
       parts += (k ? ", " : "") + file_kind_name(kinds[k]) + " " + human_bytes(result.bytes_per_kind[ri][k]);
     spdlog::info("size per frame at {}: {} ({})", resolutions[ri].name(), human_bytes(m.bytes_per_frame[ri]), parts);
   }
+  return result;
+}
+
+SceneSetRenderResult run_scene_set_render(const std::string& name, const std::vector<SceneRenderJob>& jobs,
+                                          uint64_t seed, const fs::path& out,
+                                          const std::function<void(int, int)>& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  if (jobs.empty()) throw Error(out.string(), "a scene set needs at least one scene");
+  const auto resolutions = parse_resolutions(jobs.front().options.resolutions, jobs.front().origin + ": resolutions");
+  std::vector<ManifestScene> scenes;
+  std::vector<FrameSplit> splits;
+  std::vector<std::string> names;
+  int total = 0;
+  for (const auto& job : jobs) {
+    const RenderJobOptions& o = job.options;
+    // The name is a directory name under scenes/.
+    const bool plain = !o.name.empty() && o.name[0] != '.' &&
+                       std::all_of(o.name.begin(), o.name.end(), [](unsigned char c) {
+                         return std::isalnum(c) || c == '-' || c == '_' || c == '.';
+                       });
+    if (!plain)
+      throw Error(job.origin, "scene name '" + o.name + "' must be letters, digits, '-', '_' or '.' (it names the "
+                              "scene's directory); set the scene's name");
+    for (const auto& other : jobs) {
+      if (&other == &job) break;
+      if (other.options.name == o.name)
+        throw Error(job.origin, "scene name '" + o.name + "' is also the name of the scene from " + other.origin +
+                                    "; give one of them another name");
+    }
+    if (parse_resolutions(o.resolutions, job.origin + ": resolutions") != resolutions)
+      throw Error(job.origin, "renders at " + join(o.resolutions) + ", but " + jobs.front().origin + " at " +
+                              join(jobs.front().options.resolutions) + ": every scene of a set needs the same resolutions");
+    scenes.push_back({o.name, "scenes/" + o.name, render_fingerprint(o, seed), 0, o.frames, job.weight});
+    splits.push_back(make_split(o.frames));
+    names.push_back(o.name);
+    total += o.frames;
+  }
+  SceneSetRenderResult result;
+  DatasetManifest& m = result.manifest;
+  m = scene_set_manifest(name.empty() ? join(names, "+") : name, resolutions, scenes, splits);
+  fs::create_directories(out);
+  check_resumable(out, m.fingerprint);
+  write_manifest(out, m);  // complete: false until every scene is
+  int done = 0;
+  for (const auto& job : jobs) {
+    spdlog::info("scene {}/{}: '{}' ({})", result.scenes.size() + 1, jobs.size(), job.options.name, job.origin);
+    result.scenes.push_back(run_render_job(job.options, seed, out / "scenes" / job.options.name, [&](int, int) {
+      if (progress) progress(++done, total);
+    }));
+    result.rendered += result.scenes.back().rendered;
+    result.skipped += result.scenes.back().skipped;
+  }
+  m.complete = true;
+  write_manifest(out, m);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 

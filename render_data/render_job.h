@@ -37,8 +37,9 @@ struct RenderJobOptions {
 config::Schema<EdgeSettings> edge_settings_schema();
 
 // Adds the render-job keys to a command schema whose options struct derives from RenderJobOptions.
+// `scene_required` false: the caller checks `scene` (e.g. against a scene set).
 template <class T>
-void add_render_job_fields(config::Schema<T>& s) {
+void add_render_job_fields(config::Schema<T>& s, bool scene_required = true) {
   s.field("name", static_cast<std::string T::*>(&RenderJobOptions::name), "dataset name (default: the scene's name)");
   s.field("frames", static_cast<int T::*>(&RenderJobOptions::frames), "frames to render").range(1, 1000000);
   s.field("resolutions", static_cast<std::vector<std::string> T::*>(&RenderJobOptions::resolutions),
@@ -50,9 +51,10 @@ void add_render_job_fields(config::Schema<T>& s) {
   s.section("edges", static_cast<EdgeSettings T::*>(&RenderJobOptions::edges), edge_settings_schema(),
             "edge detection thresholds");
   s.block("scene", static_cast<config::Block T::*>(&RenderJobOptions::scene), "scene source {type: procedural, ...}");
-  s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {
-    if (!o.scene.node || o.scene.node.IsNull()) at.child("scene").fail(node, "missing required key 'scene'");
-  });
+  if (scene_required)
+    s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {
+      if (!o.scene.node || o.scene.node.IsNull()) at.child("scene").fail(node, "missing required key 'scene'");
+    });
 }
 
 // Parses and checks the resolutions: sorted ascending; each must be an integer multiple (same
@@ -71,6 +73,32 @@ struct RenderJobResult {
 // Renders into `out` (created if needed). `progress` is called after each frame (done, total).
 RenderJobResult run_render_job(const RenderJobOptions& options, uint64_t seed, const std::filesystem::path& out,
                                const std::function<void(int, int)>& progress = {});
+
+// The fingerprint a render of `options` with `seed` records (its resume guard).
+std::string render_fingerprint(const RenderJobOptions& options, uint64_t seed);
+
+// One scene of a multi-scene render.
+struct SceneRenderJob {
+  RenderJobOptions options;  // options.name: the scene's name, also its directory (scenes/<name>)
+  double weight = 0;         // sampling weight (0 for every scene: proportional to training frames)
+  std::string origin;        // where the scene was configured (its config file), for errors
+};
+
+struct SceneSetRenderResult {
+  DatasetManifest manifest;           // the set's (dataset_manifest.h)
+  std::vector<RenderJobResult> scenes;
+  int rendered = 0, skipped = 0;
+  double seconds = 0;
+};
+
+// Renders every scene into `out`/scenes/<name> (each a single-scene data set that resumes as
+// run_render_job does; every scene with `seed`) and writes the set's manifest into `out`:
+// complete: false first, true when every scene is. The scenes need the same resolutions; a
+// directory holding a set of other scenes or configurations is an error. `progress` counts the
+// frames of all scenes. `name` empty: the scene names joined by '+'.
+SceneSetRenderResult run_scene_set_render(const std::string& name, const std::vector<SceneRenderJob>& jobs,
+                                          uint64_t seed, const std::filesystem::path& out,
+                                          const std::function<void(int, int)>& progress = {});
 
 // "1.2 MB", "340 KB": for size reports.
 std::string human_bytes(double bytes);

@@ -154,7 +154,8 @@ TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& fram
   // share of easy and hard ones.
   for (int f : spread_frames(frames, std::min(kMaxFrames, std::max(1, count)))) {
     out.frames.push_back(frame_batch(data, f, scale, channels, depth));
-    if (upscaler.uses_previous_frame()) out.previous.push_back(frame_batch(data, std::max(0, f - 1), scale, channels, depth));
+    if (upscaler.uses_previous_frame())
+      out.previous.push_back(frame_batch(data, data.has_previous(f) ? f - 1 : f, scale, channels, depth));
   }
   return out;
 }
@@ -184,7 +185,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   int psnr_count = 0;
   // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
   const auto upscale_frame = [&](const Batch& b, int frame) {
-    if (upscaler.uses_previous_frame() && frame > 0)
+    if (upscaler.uses_previous_frame() && data.has_previous(frame))
       upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));
     return upscaler.upscale(b);
   };
@@ -224,7 +225,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
                    b.hr_color.size(-1), b.hr_color.size(-2));
       warned_no_edges = true;
     }
-    if (temporal && frame > 0) {
+    if (temporal && data.has_previous(frame)) {  // a scene's first frame has no predecessor
       const bool consecutive = last_frame == frame - 1;
       const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels, depth);
       const auto prev_sr = consecutive ? last_sr : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
@@ -278,6 +279,31 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
     timing.finish();
   }
   return result;
+}
+
+std::vector<SceneScore> scene_scores(const EvalResult& result, const Dataset& data) {
+  std::vector<SceneScore> out;
+  for (const auto& scene : data.scenes()) {
+    SceneScore s;
+    s.scene = scene.name;
+    int finite = 0;
+    for (const auto& f : result.frames) {
+      if (!scene.contains(f.frame)) continue;
+      ++s.frames;
+      s.ssim += f.ssim;
+      if (std::isinf(f.psnr)) {
+        ++s.identical_frames;
+      } else {
+        s.psnr += f.psnr;
+        ++finite;
+      }
+    }
+    if (s.frames == 0) continue;
+    s.ssim /= s.frames;
+    s.psnr = finite ? s.psnr / finite : INFINITY;
+    out.push_back(s);
+  }
+  return out;
 }
 
 namespace {

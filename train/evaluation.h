@@ -86,6 +86,16 @@ TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& fram
 EvalResult evaluate(Upscaler& upscaler, const Dataset& dataset, const EvalOptions& options,
                     const std::function<void(const EvalResult&)>& on_quality = {});
 
+// The evaluated frames of `result` by the scene of `data` they belong to, in scene order (scenes
+// with no evaluated frame left out): mean PSNR (identical frames excluded and counted, as in the
+// overall PSNR) and SSIM.
+struct SceneScore {
+  std::string scene;
+  int frames = 0, identical_frames = 0;
+  double psnr = 0, ssim = 0;
+};
+std::vector<SceneScore> scene_scores(const EvalResult& result, const Dataset& data);
+
 nlohmann::ordered_json to_json(const EvalResult& result);
 EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::string& context);
 std::string frames_csv(const EvalResult& result);

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "cli/commands/data_merge.h"
 #include "cli/commands/data_preview.h"
 #include "core/error.h"
 #include "render_data/data_check.h"
@@ -19,10 +20,11 @@ config::Schema<DataCheckOptions> data_check_schema() {
 }
 
 void setup_data(CLI::App& app) {
-  CLI::App* data = app.add_subcommand("data", "Dataset tools: check, preview");
+  CLI::App* data = app.add_subcommand("data", "Dataset tools: check, preview, merge");
   data->require_subcommand(1);
   setup_data_check(*data);
   setup_data_preview(*data);
+  setup_data_merge(*data);
 }
 
 void setup_data_check(CLI::App& data) {
@@ -62,6 +64,7 @@ nlohmann::ordered_json run_data_check(const DataCheckOptions& options) {
   j["frames_checked"] = r.frames_checked;
   j["files_checked"] = r.files_checked;
   j["split"] = {{"train", r.split_train}, {"val", r.split_val}, {"test", r.split_test}};
+  if (!r.scenes.empty()) j["scenes"] = r.scenes;
   j["depth_range"] = {r.depth_min, r.depth_max};
   j["sky_fraction"] = r.sky_fraction;
   j["edge_fraction"] = r.edge_fraction;
@@ -75,6 +78,7 @@ nlohmann::ordered_json run_data_check(const DataCheckOptions& options) {
     std::printf("dataset      %s (%s layout, '%s')\n", options.dir.c_str(), r.layout.c_str(), r.name.c_str());
     std::printf("frames       %d at %s; split train %d / val %d / test %d\n", r.frames, join(res).c_str(), r.split_train,
                 r.split_val, r.split_test);
+    if (!r.scenes.empty()) std::printf("scenes       %s\n", join(r.scenes).c_str());
     std::printf("channels     %s%s\n", join(r.channels).c_str(),
                 r.derived.empty() ? "" : (" (derived: " + join(r.derived) + ")").c_str());
     std::printf("checked      %lld frame/resolution pairs, %lld files\n", static_cast<long long>(r.frames_checked),

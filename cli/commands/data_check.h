@@ -2,7 +2,7 @@
 // `cgsr data check DIR`: validates a dataset (every frame at every resolution, sizes consistent
 // with the scale, no NaN/Inf, value ranges) and prints a summary with counts. Exits with code 2
 // when problems were found. `cgsr data` is the group; `setup_data` adds it with its
-// subcommands (check, preview).
+// subcommands (check, preview, merge).
 
 #include <CLI/CLI.hpp>
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/atomic_file.h"
+#include "core/metrics.h"
 #include "models/model_file.h"
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
@@ -15,6 +16,8 @@ namespace cgsr::cli {
 config::Schema<EvalCommandOptions> eval_schema() {
   config::Schema<EvalCommandOptions> s;
   s.field("data", &EvalCommandOptions::data, "data set directory").required();
+  s.field("scene", &EvalCommandOptions::scene, "evaluate one scene of a multi-scene data set (default: all)");
+  s.omit_when("scene", [](const EvalCommandOptions& o) { return o.scene.empty(); });  // `cgsr run`'s eval hash as before
   s.field("models", &EvalCommandOptions::models,
           "model files and classic upscalers (" + join(classic_upscalers().names()) + ", or 'classic' for all)")
       .check([](const auto& v) { return !v.empty(); }, "needs at least one model or upscaler");
@@ -53,6 +56,7 @@ void setup_eval(CLI::App& app) {
               flags.push_back({"models=" + list + "]", "--model"});
             },
             "model file or classic upscaler name (repeatable; 'classic' = all classic upscalers)");
+        flag_to_key(sub, flags, "--scene", "scene", "one scene of a multi-scene data set");
         flag_to_key(sub, flags, "--split", "eval.split", "data set split");
         flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");
         flag_to_key(sub, flags, "--crop-border", "eval.crop_border", "HR pixels ignored at each border");
@@ -101,10 +105,12 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   }
   std::vector<std::unique_ptr<Upscaler>> upscalers;
   for (const auto& [entry, name] : entries) upscalers.push_back(make_upscaler(entry, name, options.scale));
-  const Dataset data = open_for(options.data, upscalers, options.eval.temporal);
+  Dataset data = open_for(options.data, upscalers, options.eval.temporal);
+  if (!options.scene.empty()) data = data.scene(options.scene);
   std::vector<EvalResult> results;
   nlohmann::ordered_json json;
   json["data"] = data.info().root.string();
+  if (!options.scene.empty()) json["scene"] = options.scene;
   json["evaluations"] = nlohmann::ordered_json::array();
   // Each model's figures are written as soon as its quality is known: at 1080p the latency of the
   // next models can take many minutes.
@@ -119,6 +125,19 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
     EvalResult r = evaluate(*upscaler, data, options.eval, write_results);
     if (r.latency) spdlog::info("{}: latency {:.2f} ms (median of {})", r.name, r.latency->median_ms, r.latency->runs);
     json["evaluations"].push_back(to_json(r));
+    if (data.scenes().size() > 1) {  // a multi-scene data set: quality per scene as well
+      auto& per_scene = json["evaluations"].back()["scenes"];
+      per_scene = nlohmann::ordered_json::array();
+      for (const SceneScore& s : scene_scores(r, data)) {
+        nlohmann::ordered_json j = {{"scene", s.scene}, {"frames", s.frames}};
+        put_psnr(j, "psnr", s.psnr);
+        j["ssim"] = s.ssim;
+        j["identical_frames"] = s.identical_frames;
+        per_scene.push_back(j);
+        spdlog::info("{} on scene '{}': PSNR {:.3f} dB, SSIM {:.4f} on {} frame(s)", r.name, s.scene, s.psnr, s.ssim,
+                     s.frames);
+      }
+    }
     results.push_back(std::move(r));
   }
   const auto tables = group_results(results);

@@ -11,6 +11,7 @@ namespace cgsr::cli {
 
 struct EvalCommandOptions : RunSettings {
   std::string data;                 // data set directory (required)
+  std::string scene;                // one scene of a multi-scene data set; empty: every scene
   std::vector<std::string> models;  // model files, classic upscaler names, or "classic" for all of them
   std::vector<std::string> names;   // display names, in the order of `models` (optional)
   int scale = 2;                    // scale of the classic upscalers (model files carry their own)

@@ -2,6 +2,15 @@
 // `cgsr render --config configs/scenes/NAME.yaml --out DIR`: renders a scene at every requested
 // resolution into the cgsr dataset format (render_data/render_job.h, DATASET_FORMAT.md).
 // Re-running the same command on a partly rendered DIR resumes it.
+//
+// Several scenes into one data set: `cgsr render --scene a.yaml --scene b.yaml --out DIR`, or a
+// scene-set config:
+//   name: mixed
+//   scenes:
+//     - {config: configs/scenes/default.yaml}
+//     - {config: configs/scenes/arena.yaml, weight: 2, frames: 60}   # name, weight, frames optional
+// Each entry is a scene config as above, rendered as it says (with the command's seed) into
+// DIR/scenes/<name>; DIR/manifest.yaml lists the scenes (dataset_manifest.h).
 
 #include <CLI/CLI.hpp>
 
@@ -10,7 +19,17 @@
 
 namespace cgsr::cli {
 
-struct RenderOptions : RunSettings, RenderJobOptions {};
+// A scene of a scene set.
+struct SceneSetEntry {
+  std::string config;  // a scene's render config (configs/scenes/*.yaml)
+  std::string name;    // empty: the config's name, else the file's stem
+  double weight = 0;   // sampling weight; 0 for every entry: proportional to training frames
+  int frames = 0;      // 0: the config's
+};
+
+struct RenderOptions : RunSettings, RenderJobOptions {
+  std::vector<SceneSetEntry> scenes;  // a scene set instead of `scene`
+};
 
 config::Schema<RenderOptions> render_schema();
 void setup_render(CLI::App& app);

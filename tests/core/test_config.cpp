@@ -171,6 +171,19 @@ TEST(Config, EmitRoundTrips) {
   EXPECT_EQ(again.lights[0].kind, "directional");
 }
 
+TEST(Config, OmittedKeysLeaveTheEmittedConfigWhileTheyDoNotApply) {
+  Schema<SceneOptions> schema = scene_schema();
+  schema.omit_when("lights", [](const SceneOptions& o) { return o.lights.empty(); });
+  const auto without = parse_document(Document::parse("name: hall\n", "a"), schema);
+  const YAML::Node a = schema.emit(without);
+  EXPECT_FALSE(a["lights"]);
+  EXPECT_TRUE(a["frames"]);
+  const auto with = parse_document(Document::parse("name: hall\nlights: [{kind: point}]\n", "b"), schema);
+  EXPECT_EQ(schema.emit(with)["lights"].size(), 1u);
+  // The emitted config still parses to the same options.
+  EXPECT_TRUE(parse_document(Document::parse(to_yaml(a), "emitted"), schema).lights.empty());
+}
+
 TEST(Config, MissingFileIsAnError) {
   try {
     Document::load_file("/nonexistent/x.yaml");

@@ -1,0 +1,70 @@
+#include "cli/commands/data_merge.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "render_data/dataset_manifest.h"
+
+namespace cgsr::cli {
+
+config::Schema<DataMergeOptions> data_merge_schema() {
+  config::Schema<DataMergeOptions> s;
+  s.field("data", &DataMergeOptions::data, "data set directories to merge (each single- or multi-scene)")
+      .check([](const std::vector<std::string>& v) { return !v.empty(); }, "needs at least one data set");
+  s.field("weights", &DataMergeOptions::weights,
+          "sampling weight per data set (none: scenes in proportion to their training frames)")
+      .check([](const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), [](double w) { return w > 0; }); },
+             "weights must be positive");
+  s.field("name", &DataMergeOptions::name, "name of the merged data set (default: the scene names joined by '+')");
+  s.validate([](const DataMergeOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.weights.empty() && o.weights.size() != o.data.size())
+      at.child("weights").fail(node["weights"] ? node["weights"] : node,
+                               "give one weight per data set (" + std::to_string(o.data.size()) + ")");
+  });
+  add_run_settings(s);
+  return s;
+}
+
+void setup_data_merge(CLI::App& data) {
+  add_command<DataMergeOptions>(
+      data, "merge", "One multi-scene data set from existing data sets (a manifest that refers to them, no copies)",
+      data_merge_schema,
+      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
+        sub.add_option_function<std::vector<std::string>>(
+            "data",
+            [&flags](const std::vector<std::string>& dirs) {
+              std::string list = "[";
+              for (size_t i = 0; i < dirs.size(); ++i) list += (i ? ", " : "") + ("'" + dirs[i] + "'");
+              flags.push_back({"data=" + list + "]", "DATA"});
+            },
+            "data set directories");
+      },
+      [](const DataMergeOptions& options, const YAML::Node&, RunDir* run_dir) {
+        return run_data_merge(options, run_dir->path());
+      },
+      /*always_run_dir=*/true);
+}
+
+nlohmann::ordered_json run_data_merge(const DataMergeOptions& options, const std::filesystem::path& out) {
+  std::vector<std::filesystem::path> dirs(options.data.begin(), options.data.end());
+  const DatasetManifest m = merge_manifests(out, options.name, dirs, options.weights);
+  write_manifest(out, m);
+  nlohmann::ordered_json j;
+  j["dataset"] = out.string();
+  j["name"] = m.name;
+  j["frames"] = m.frames;
+  j["split"] = {{"train", m.split.train.size()}, {"val", m.split.val.size()}, {"test", m.split.test.size()}};
+  j["scenes"] = nlohmann::ordered_json::array();
+  std::printf("merged %zu scene(s), %d frames, into '%s' in %s\n", m.scenes.size(), m.frames, m.name.c_str(),
+              out.string().c_str());
+  for (const auto& s : m.scenes) {
+    j["scenes"].push_back({{"name", s.name}, {"path", s.path}, {"first_frame", s.first_frame}, {"frames", s.frames},
+                           {"weight", s.weight}});
+    std::printf("  %-16s frames %d..%d from %s", s.name.c_str(), s.first_frame, s.first_frame + s.frames - 1, s.path.c_str());
+    if (s.weight > 0) std::printf(", weight %g", s.weight);
+    std::printf("\n");
+  }
+  return j;
+}
+
+}  // namespace cgsr::cli
