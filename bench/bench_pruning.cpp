@@ -3,7 +3,7 @@
 // interleaved rounds (one frame of each per round, after warm-up), so drift on a shared machine
 // hits all alike. Every target runs on cgsr's fast path (models/fused_graph.h).
 //
-//   bench_pruning --model runs/quickstart/prune/pruned.cgsr --data runs/quickstart/data \
+//   bench_pruning --model runs/quickstart/prune/pruned.cgsr --data runs/quickstart/data
 //     [--baseline runs/quickstart/prune/baseline0_magnitude.cgsr ...] [--split test] [--rounds N] [--threads N]
 //
 // Prints, per target, mean, median and p95 per frame and the mean against the static network's:
