@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "render_data/frame_files.h"
 #include "render_data/renderer.h"
 #include "render_data/scene_source.h"
@@ -55,8 +56,7 @@ std::string fingerprint(const RenderJobOptions& o, uint64_t seed) {
                      std::to_string(o.edges.depth_threshold) + "|" + std::to_string(o.edges.crease_angle) + "|" +
                      std::to_string(o.edges.id_changes);
   for (const auto& r : o.resolutions) text += "|" + r;
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  const uint64_t h = fnv1a64(text, kLegacySeedBasis);  // legacy basis: existing dataset fingerprints stay valid
   char buf[20];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;
