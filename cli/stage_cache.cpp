@@ -15,7 +15,7 @@ const char* kRecord = "stage.json";
 std::string stage_hash(const YAML::Node& config, const std::vector<std::string>& upstream) {
   std::string text = config::to_yaml(config);
   for (const auto& h : upstream) text += "\n@" + h;
-  const uint64_t h = fnv1a64(text, kLegacySeedBasis);  // legacy basis: existing stage caches stay current
+  const uint64_t h = fnv1a64(text, kLegacyFnv1a64Basis);  // legacy basis: existing stage caches stay current
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;

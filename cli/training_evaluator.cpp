@@ -30,7 +30,7 @@ config::Schema<CandidateTraining> candidate_training_schema() {
 namespace {
 // A stable hash of the spec text, so a candidate's seed does not depend on evaluation order; the
 // legacy basis keeps the seeds (and so the search results) of earlier runs.
-uint64_t text_hash(const std::string& text) { return fnv1a64(text, kLegacySeedBasis); }
+uint64_t text_hash(const std::string& text) { return fnv1a64(text, kLegacyFnv1a64Basis); }
 }  // namespace
 
 TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options)

@@ -49,7 +49,7 @@ void seed_everything(uint64_t seed) {
 uint64_t global_seed() { return seed_storage(); }
 
 std::mt19937_64 make_rng(const char* purpose, uint64_t extra) {
-  const uint64_t h = fnv1a64(purpose, kLegacySeedBasis);  // legacy basis: every seeded stream stays the same
+  const uint64_t h = fnv1a64(purpose, kLegacyFnv1a64Basis);  // legacy basis: every seeded stream stays the same
   return std::mt19937_64(mix(seed_storage() ^ mix(h) ^ mix(extra + 1)));
 }
 

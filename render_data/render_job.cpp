@@ -56,7 +56,7 @@ std::string fingerprint(const RenderJobOptions& o, uint64_t seed) {
                      std::to_string(o.edges.depth_threshold) + "|" + std::to_string(o.edges.crease_angle) + "|" +
                      std::to_string(o.edges.id_changes);
   for (const auto& r : o.resolutions) text += "|" + r;
-  const uint64_t h = fnv1a64(text, kLegacySeedBasis);  // legacy basis: existing dataset fingerprints stay valid
+  const uint64_t h = fnv1a64(text, kLegacyFnv1a64Basis);  // legacy basis: existing dataset fingerprints stay valid
   char buf[20];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;

@@ -27,8 +27,8 @@ TEST(Hash, LegacyBasisReproducesTheOldCopies) {
   };
   const std::vector<std::string> texts{"", "patch_sampler", "backbone: pan\nscale: 2\n", std::string("\x00\xff\x80", 3)};
   for (const auto& text : texts)
-    EXPECT_EQ(fnv1a64(text, kLegacySeedBasis), old_loop(text)) << text;
+    EXPECT_EQ(fnv1a64(text, kLegacyFnv1a64Basis), old_loop(text)) << text;
   // Pinned values: a change here changes every reproduced seed and cache key.
-  EXPECT_EQ(fnv1a64("", kLegacySeedBasis), 1469598103934665603ull);
-  EXPECT_EQ(fnv1a64("a", kLegacySeedBasis), (1469598103934665603ull ^ 'a') * 1099511628211ull);
+  EXPECT_EQ(fnv1a64("", kLegacyFnv1a64Basis), 1469598103934665603ull);
+  EXPECT_EQ(fnv1a64("a", kLegacyFnv1a64Basis), (1469598103934665603ull ^ 'a') * 1099511628211ull);
 }
