@@ -88,7 +88,7 @@ nlohmann::ordered_json run_hybrid_export(const ExportCommandOptions& options, co
   results["format"] = enum_name(o.format);
   std::printf("%s: hybrid-pruned %s, %d patterns (%s) + selector\n", exported.dir.string().c_str(),
               exported.manifest.at("model").get<std::string>().c_str(), static_cast<int>(exported.patterns.size()),
-              enum_name(o.format));
+              enum_name(o.format).c_str());
   std::printf("  %s\n", signature_string(exported.patterns.front().signature, o.width, o.height).c_str());
   std::printf("  %-16s %8s %10s %10s %10s\n", "file", "channels", "MACs", "KiB", "latency");
   auto files = nlohmann::ordered_json::array();
@@ -154,7 +154,7 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   results["signature"] = exported.dynamic_size ? signature_string(exported.signature, w, h) + " (any size)"
                                                : signature_string(exported.signature, w, h);
   std::printf("%s: %s, %s\n", exported.file.string().c_str(), results["model"].get<std::string>().c_str(),
-              enum_name(exported.format));
+              enum_name(exported.format).c_str());
   std::printf("  %s\n", results["signature"].get<std::string>().c_str());
   if (exported.format == ExportFormat::Onnx) {
     const OnnxModelInfo info = inspect_onnx_file(exported.file);
