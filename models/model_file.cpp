@@ -188,7 +188,7 @@ std::vector<torch::Tensor> read_archive_weights(std::string_view zip, const std:
         !std::all_of(rest.begin() + 5, rest.end(), [](char c) { return c >= '0' && c <= '9'; }))
       continue;
     const std::string record(name);
-    if (method != 0 || size != stored_size) throw bad("record " + record + " is compressed");
+    if (method != 0 || size != stored_size) throw bad("record " + record + " is compressed or its sizes disagree");
     if (local > zip.size() || zip.size() - local < kLocalSize || get_le<uint32_t>(zip, local) != 0x04034b50)
       throw bad("record " + record + " has no local header");
     const uint64_t data = local + kLocalSize + get_le<uint16_t>(zip, local + 26) + get_le<uint16_t>(zip, local + 28);
