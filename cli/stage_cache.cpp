@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/hash.h"
 
 namespace cgsr::cli {
 namespace {
@@ -14,8 +15,7 @@ const char* kRecord = "stage.json";
 std::string stage_hash(const YAML::Node& config, const std::vector<std::string>& upstream) {
   std::string text = config::to_yaml(config);
   for (const auto& h : upstream) text += "\n@" + h;
-  uint64_t h = 1469598103934665603ULL;  // FNV-1a 64
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  const uint64_t h = fnv1a64(text, kLegacyFnv1a64Basis);  // legacy basis: existing stage caches stay current
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;

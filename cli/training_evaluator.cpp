@@ -5,6 +5,7 @@
 
 #include <chrono>
 
+#include "core/hash.h"
 #include "core/runtime.h"
 #include "core/timing.h"
 #include "models/complexity.h"
@@ -27,12 +28,9 @@ config::Schema<CandidateTraining> candidate_training_schema() {
 }
 
 namespace {
-// FNV-1a: a stable hash of the spec text, so a candidate's seed does not depend on evaluation order.
-uint64_t text_hash(const std::string& text) {
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
-  return h;
-}
+// A stable hash of the spec text, so a candidate's seed does not depend on evaluation order; the
+// legacy basis keeps the seeds (and so the search results) of earlier runs.
+uint64_t text_hash(const std::string& text) { return fnv1a64(text, kLegacyFnv1a64Basis); }
 }  // namespace
 
 TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options)

@@ -320,7 +320,9 @@ class Schema {
     std::set<std::string> seen;
     if (node && node.IsMap()) {
       for (const auto& kv : node) {
-        const std::string key = kv.first.as<std::string>();
+        // A list or map as a key ("? [a, b]: 1", "{a: 1}: 2") is valid YAML but names no field.
+        if (!kv.first.IsScalar()) at.fail(kv.first, "a key must be a name, got " + detail::describe(kv.first));
+        const std::string key = kv.first.Scalar();
         if (std::find(reserved.begin(), reserved.end(), key) != reserved.end()) continue;
         const Field* f = find(key);
         if (!f) {

@@ -5,6 +5,8 @@
 #include <memory>
 #include <thread>
 
+#include "core/hash.h"
+
 namespace cgsr {
 namespace {
 std::unique_ptr<tbb::global_control>& tbb_limit() {
@@ -47,8 +49,7 @@ void seed_everything(uint64_t seed) {
 uint64_t global_seed() { return seed_storage(); }
 
 std::mt19937_64 make_rng(const char* purpose, uint64_t extra) {
-  uint64_t h = 1469598103934665603ULL;  // FNV-1a over the purpose string
-  for (const char* p = purpose; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
+  const uint64_t h = fnv1a64(purpose, kLegacyFnv1a64Basis);  // legacy basis: every seeded stream stays the same
   return std::mt19937_64(mix(seed_storage() ^ mix(h) ^ mix(extra + 1)));
 }
 

@@ -1,7 +1,9 @@
-// Fuzz target for model files (models/model_file): header, metadata JSON, spec, weights. The
-// target rewrites the trailing checksum to match the mutated bytes, so inputs get past the
-// corruption check into the parser behind it. Every input must load or be rejected with
-// cgsr::Error; a loaded network must hold only finite weights. Seeds: fuzz/corpus/model_file.
+// Fuzz target for model files (models/model_file): header, metadata JSON, spec, weights, in both
+// format versions (raw float32 weights in version 2, a torch::save archive in version 1). The
+// target rewrites the trailing checksum to match the mutated bytes (with the basis of the version
+// the bytes declare), so inputs get past the corruption check into the parser behind it. Every
+// input must load or be rejected with cgsr::Error; a loaded network must hold only finite weights.
+// Seeds: fuzz/corpus/model_file (a version 2 file from make_seeds.sh and the version 1 test fixture).
 
 #include <cstddef>
 #include <cstdint>

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates the seed inputs in fuzz/corpus/ from what cgsr itself writes: the manifest and
 # the 64x48 files of frame 0 of configs/scenes/tiny.yaml, and a small CG-enhanced PAN model
-# file. Config seeds are the files in configs/ (the fuzz tests read them there).
+# file (format version 2) next to the version 1 test fixture (tests/data/model_file_v1.cgsr, which
+# this cgsr can no longer write). Config seeds are the files in configs/ (the fuzz tests read them
+# there).
 #   fuzz/make_seeds.sh [BUILD_DIR]     (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,4 +30,5 @@ printf 'backbone: pan\nscale: 2\nblocks: 1\nwidths: {features: 8}\n' > "$work/sp
   --set schedule.steps=2 --set schedule.batch_size=1 --set schedule.patch_size=16 \
   --set schedule.validate_every=0 --set schedule.val_frames=1 >/dev/null
 cp "$work/train/model.cgsr" fuzz/corpus/model_file/pan_cg_tiny.cgsr
+cp tests/data/model_file_v1.cgsr fuzz/corpus/model_file/pan_cg_tiny_v1.cgsr
 ls -l fuzz/corpus/*

@@ -3,19 +3,31 @@
 //
 //   offset  size  content
 //   0       8     magic "CGSRMODL"
-//   8       4     format version (little-endian uint32, currently 1)
+//   8       4     format version (little-endian uint32): 2 is written, 1 and 2 are read
 //   12      8     metadata length M (little-endian uint64)
 //   20      8     weights length W (little-endian uint64)
 //   28      M     metadata: UTF-8 JSON {format, version, spec (YAML text), channels,
-//                 provenance {stage, parent, config, metrics, extra}, tensors [{name, shape}]}
-//   28+M    W     weights: torch::save of the tensors, in the metadata's order
-//   28+M+W  8     FNV-1a 64 checksum of every byte before it (little-endian)
+//                 provenance {stage, parent, config, metrics, extra},
+//                 tensors [{name, dtype, shape}]}
+//   28+M    W     weights: version 2: each tensor's values as raw little-endian float32
+//                 (dtype "float32"), row-major, in the metadata's order, back to back; version 1:
+//                 a torch::save archive of the tensors
+//   28+M+W  8     FNV-1a 64 of every byte before it (little-endian); version 1 files used the
+//                 offset basis 1469598103934665603 (a digit short of FNV-1a's) and keep it
 //
-// Files are written atomically. Reading checks magic, version, lengths (truncation), the
-// checksum (corruption), the spec (the same validation as a spec file) and that the weights are
-// exactly the spec's parameters with the spec's shapes; every failure is a cgsr::Error naming
-// the file.
+// Files are written atomically. Reading is bounded by the file: it checks magic, version, the
+// limits below, lengths (truncation) and the checksum (corruption) before it parses anything, then
+// every tensor's declared shape (non-negative, at most kMaxTensorRank dimensions, an element count
+// that fits the weight bytes left) before it allocates any tensor, then the spec (the same
+// validation as a spec file). Version 1 weights are read without LibTorch's deserializer, which
+// allocates what sizes inside the archive say: tensor i is the archive's stored record data/i,
+// which must be exactly the size of the tensor's declared shape (cgsr wrote each tensor with its
+// own storage, in the metadata's order). load_model then builds the spec's network with the stored
+// values as its parameter budget and checks the weights are exactly its parameters. Every failure
+// is a cgsr::Error naming the file (and the tensor, when one is at fault).
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -52,7 +64,14 @@ struct ModelFileContents {
   std::vector<std::pair<std::string, torch::Tensor>> tensors;  // parameter name -> value
 };
 
-// The trailing checksum of a model file whose bytes before the checksum are `bytes`.
+// What a model file may hold: a reader refuses (and the writer never writes) more.
+inline constexpr uint64_t kMaxModelWeightBytes = uint64_t{1} << 31;    // 2 GiB of tensor values
+inline constexpr uint64_t kMaxModelMetadataBytes = uint64_t{16} << 20;  // 16 MiB of JSON
+inline constexpr size_t kMaxModelTensors = 65536;
+inline constexpr size_t kMaxTensorRank = 8;
+
+// The trailing checksum of a model file whose bytes before the checksum are `bytes`: FNV-1a 64,
+// with the legacy basis when the version field in `bytes` says 1.
 uint64_t model_file_checksum(std::string_view bytes);
 
 void write_model_file(const std::filesystem::path& path, const ModelFileContents& contents);

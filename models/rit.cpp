@@ -32,9 +32,11 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
       upsample_factor_(features.factor) {
   const int64_t c = total_width(rit.render_channels());
   CGSR_CHECK(c > 0 && rit.width > 0 && rit.hr_width > 0, "RIT needs channels and positive widths");
+  ParameterBudget::charge(c);
   gate = register_parameter("gate", torch::ones({c}));
   if (rit.feature_branch()) {
     // Space-to-depth + conv 3x3 == a conv of kernel 3s, stride s, padding s on the HR map.
+    ParameterBudget::charge_conv(c, rit.width, 3 * stride_, 1, /*bias=*/true);
     conv = register_module("conv", torch::nn::Conv2d(torch::nn::Conv2dOptions(c, rit.width, 3 * stride_)
                                                          .stride(stride_)
                                                          .padding(stride_)));

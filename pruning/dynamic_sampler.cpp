@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/tensor_checks.h"
 #include "core/text.h"
+#include "models/layers.h"
 
 namespace cgsr {
 
@@ -73,6 +74,8 @@ DynamicSamplersImpl::DynamicSamplersImpl(const SamplerOptions& options, std::vec
   for (int k : patterns_) CGSR_CHECK(k >= 1, "every unit needs at least one pattern");
   in_channels_ = 2 * total_width(options_.render_channels());
   const int64_t u = static_cast<int64_t>(patterns_.size()), w = options_.width;
+  ParameterBudget::charge_conv(in_channels_, u * w, 3, 1, /*bias=*/true);
+  ParameterBudget::charge_conv(u * w, u * w, 3, u, /*bias=*/true);
   conv1 = register_module("conv1", torch::nn::Conv2d(torch::nn::Conv2dOptions(in_channels_, u * w, 3).padding(1)));
   conv2 = register_module("conv2", torch::nn::Conv2d(torch::nn::Conv2dOptions(u * w, u * w, 3).padding(1).groups(u)));
   build_head();
@@ -81,6 +84,7 @@ DynamicSamplersImpl::DynamicSamplersImpl(const SamplerOptions& options, std::vec
 void DynamicSamplersImpl::build_head() {
   const int64_t u = static_cast<int64_t>(patterns_.size()), w = options_.width;
   const int64_t k = *std::max_element(patterns_.begin(), patterns_.end());
+  ParameterBudget::charge_conv(u * w, u * k, 1, u, /*bias=*/true);
   auto fresh = torch::nn::Conv2d(torch::nn::Conv2dOptions(u * w, u * k, 1).groups(u));
   if (head.is_empty()) {
     head = register_module("head", fresh);

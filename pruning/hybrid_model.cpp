@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/tensor_checks.h"
+#include "models/layers.h"
 
 namespace cgsr {
 
@@ -77,7 +78,15 @@ HybridModel load_hybrid_model(const std::filesystem::path& path) {
                            " entries, the pool " + std::to_string(model.pool.size()) + " patterns");
   for (double ms : model.latency.median_ms)
     if (!std::isfinite(ms) || ms < 0) throw Error(where, "the latency table holds an invalid time");
-  model.samplers = DynamicSamplers(options, std::vector<int>{model.pool.size()});
+  {
+    // The samplers' width comes from the metadata: bounded by what the file stores for them (as in
+    // load_model, twice that plus 4 MiB, so near misses get the per-tensor message below).
+    int64_t stored = 0;
+    for (const auto& [name, value] : contents.tensors)
+      if (name.rfind(kPrefix, 0) == 0) stored += value.numel();
+    const ParameterBudget budget(2 * stored + (int64_t{1} << 20), where);
+    model.samplers = DynamicSamplers(options, std::vector<int>{model.pool.size()});
+  }
   auto params = model.samplers->named_parameters(/*recurse=*/true);
   std::set<std::string> seen;
   torch::NoGradGuard no_grad;

@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/text.h"
 
 namespace cgsr {
@@ -106,8 +107,7 @@ fs::path DatasetManifest::file(const fs::path& root, int frame, size_t resolutio
 bool has_manifest(const fs::path& root) { return fs::exists(root / "manifest.yaml"); }
 
 std::string hex_fingerprint(const std::string& text) {
-  uint64_t h = 1469598103934665603ULL;  // FNV-1a 64
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  const uint64_t h = fnv1a64(text, kLegacyFnv1a64Basis);  // legacy basis: existing data set fingerprints stay valid
   char buf[20];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;

@@ -95,6 +95,15 @@ TEST(Config, UnknownKeySuggestsTheClosestAndGivesLineAndColumn) {
   EXPECT_NE(e.find("did you mean 'fov'"), std::string::npos) << e;
 }
 
+TEST(Config, AKeyThatIsAListOrAMapIsAnErrorWithItsLocation) {
+  // Found by fuzz_config: yaml-cpp's bad-conversion exception escaped the schema.
+  auto e = error_of("name: hall\ncamera:\n  ? [fov, near]\n  : 70\n");
+  EXPECT_NE(e.find("scene.yaml:3:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("a key must be a name, got a list"), std::string::npos) << e;
+  e = error_of("name: hall\n{frames: 3}: 2\n");
+  EXPECT_NE(e.find("a key must be a name, got a map"), std::string::npos) << e;
+}
+
 TEST(Config, WrongTypeOutOfRangeAndMissingKeys) {
   auto e = error_of("name: hall\nframes: many\n");
   EXPECT_NE(e.find("scene.yaml:2:9: frames: expected an integer, got 'many'"), std::string::npos) << e;
