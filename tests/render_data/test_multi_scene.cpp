@@ -4,10 +4,6 @@
 // and `cgsr eval --scene`. Real frames of the tiny scene, rendered once for the whole file.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -18,27 +14,14 @@
 #include "render_data/dataset_manifest.h"
 #include "render_data/patch_sampler.h"
 #include "test_scenes.h"
+#include "tests/support/cli_runner.h"
 
 namespace cgsr {
 namespace multi_scene_test {  // named: the unity build joins this file with test_render_cli.cpp
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string output;
-};
-
-CliRun cgsr(const std::string& args) {
-  const std::string command = std::string(CGSR_BINARY) + " " + args + " 2>&1";
-  CliRun r;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::CliResult;
+using test::run_cgsr;
 
 std::string tiny_config() { return std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml"; }
 
@@ -75,11 +58,11 @@ const Renders& renders() {
     x.root = test::temp_dir("multi_scene");
     x.scene_b = second_scene_config(x.root);
     x.set = x.root / "set";
-    const CliRun set = cgsr("render --scene " + tiny_config() + " --scene " + x.scene_b.string() + " --out " + x.set.string());
-    EXPECT_EQ(set.code, 0) << set.output;
+    const CliResult set = run_cgsr("render --scene " + tiny_config() + " --scene " + x.scene_b.string() + " --out " + x.set.string());
+    EXPECT_EQ(set.exit_code, 0) << set.all();
     x.solo = x.root / "solo";
-    const CliRun solo = cgsr("render --config " + tiny_config() + " --out " + x.solo.string());
-    EXPECT_EQ(solo.code, 0) << solo.output;
+    const CliResult solo = run_cgsr("render --config " + tiny_config() + " --out " + x.solo.string());
+    EXPECT_EQ(solo.exit_code, 0) << solo.all();
     return x;
   }();
   return r;
@@ -151,10 +134,10 @@ TEST(MultiSceneRender, RecordsScenesAndSplitsEachScene) {
     EXPECT_NE(std::string(e.what()).find("did you mean 'tiny_b'"), std::string::npos) << e.what();
   }
 
-  const CliRun check = cgsr("data check " + r.set.string());
-  EXPECT_EQ(check.code, 0) << check.output;
-  EXPECT_NE(check.output.find("scenes       tiny (6 frames), tiny_b (10 frames)"), std::string::npos) << check.output;
-  EXPECT_NE(check.output.find("32 frame/resolution pairs"), std::string::npos) << check.output;
+  const CliResult check = run_cgsr("data check " + r.set.string());
+  EXPECT_EQ(check.exit_code, 0) << check.all();
+  EXPECT_NE(check.all().find("scenes       tiny (6 frames), tiny_b (10 frames)"), std::string::npos) << check.all();
+  EXPECT_NE(check.all().find("32 frame/resolution pairs"), std::string::npos) << check.all();
 }
 
 TEST(MultiSceneRender, ResumesAndRefusesAnotherSet) {
@@ -164,22 +147,22 @@ TEST(MultiSceneRender, ResumesAndRefusesAnotherSet) {
   // The set's manifest says complete: false while a scene is unfinished.
   fs::remove(copy / "scenes" / "tiny_b" / "128x96" / "edge" / "000004.png");
   const std::string args = "render --scene " + tiny_config() + " --scene " + r.scene_b.string() + " --out " + copy.string();
-  const CliRun resume = cgsr(args);
-  ASSERT_EQ(resume.code, 0) << resume.output;
-  EXPECT_NE(resume.output.find("rendered 1 frame(s) (15 resumed) of 2 scenes"), std::string::npos) << resume.output;
+  const CliResult resume = run_cgsr(args);
+  ASSERT_EQ(resume.exit_code, 0) << resume.all();
+  EXPECT_NE(resume.all().find("rendered 1 frame(s) (15 resumed) of 2 scenes"), std::string::npos) << resume.all();
   EXPECT_TRUE(read_manifest(copy).complete);
 
-  const CliRun other = cgsr("render --scene " + tiny_config() + " --out " + copy.string());
-  EXPECT_EQ(other.code, 2) << other.output;
-  EXPECT_NE(other.output.find("different configuration"), std::string::npos) << other.output;
+  const CliResult other = run_cgsr("render --scene " + tiny_config() + " --out " + copy.string());
+  EXPECT_EQ(other.exit_code, 2) << other.all();
+  EXPECT_NE(other.all().find("different configuration"), std::string::npos) << other.all();
   // Two scenes under one name, and single-scene keys at the top of a set, are config errors.
-  const CliRun twice = cgsr("render --scene " + tiny_config() + " --scene " + tiny_config() + " --out " +
+  const CliResult twice = run_cgsr("render --scene " + tiny_config() + " --scene " + tiny_config() + " --out " +
                             (r.root / "twice").string());
-  EXPECT_EQ(twice.code, 2) << twice.output;
-  EXPECT_NE(twice.output.find("scene name 'tiny' is also the name of the scene from"), std::string::npos) << twice.output;
-  const CliRun frames = cgsr("render --scene " + tiny_config() + " --frames 3 --out " + (r.root / "frames").string());
-  EXPECT_EQ(frames.code, 2) << frames.output;
-  EXPECT_NE(frames.output.find("'frames' is each scene's own"), std::string::npos) << frames.output;
+  EXPECT_EQ(twice.exit_code, 2) << twice.all();
+  EXPECT_NE(twice.all().find("scene name 'tiny' is also the name of the scene from"), std::string::npos) << twice.all();
+  const CliResult frames = run_cgsr("render --scene " + tiny_config() + " --frames 3 --out " + (r.root / "frames").string());
+  EXPECT_EQ(frames.exit_code, 2) << frames.all();
+  EXPECT_NE(frames.all().find("'frames' is each scene's own"), std::string::npos) << frames.all();
 }
 
 TEST(MultiSceneRender, SceneSetConfigWithWeightsAndFrames) {
@@ -188,8 +171,8 @@ TEST(MultiSceneRender, SceneSetConfigWithWeightsAndFrames) {
   std::ofstream(config) << "name: weighted\nscenes:\n  - {config: " << tiny_config()
                         << ", weight: 3, frames: 4}\n  - {config: " << r.scene_b.string() << ", name: b, weight: 1}\n";
   const fs::path out = r.root / "weighted";
-  const CliRun run = cgsr("render --config " + config.string() + " --out " + out.string());
-  ASSERT_EQ(run.code, 0) << run.output;
+  const CliResult run = run_cgsr("render --config " + config.string() + " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.all();
   const DatasetManifest m = read_manifest(out);
   ASSERT_EQ(m.scenes.size(), 2u);
   EXPECT_EQ(m.name, "weighted");
@@ -200,9 +183,9 @@ TEST(MultiSceneRender, SceneSetConfigWithWeightsAndFrames) {
   // The resolved config lists the scenes only, and renders the same set again.
   const std::string resolved = read_text(out / "config.yaml");
   EXPECT_EQ(resolved.find("frames: 90"), std::string::npos) << resolved;
-  const CliRun again = cgsr("render --config " + (out / "config.yaml").string() + " --out " + out.string());
-  ASSERT_EQ(again.code, 0) << again.output;
-  EXPECT_NE(again.output.find("rendered 0 frame(s) (14 resumed)"), std::string::npos) << again.output;
+  const CliResult again = run_cgsr("render --config " + (out / "config.yaml").string() + " --out " + out.string());
+  ASSERT_EQ(again.exit_code, 0) << again.all();
+  EXPECT_NE(again.all().find("rendered 0 frame(s) (14 resumed)"), std::string::npos) << again.all();
 }
 
 // Frames drawn by batches 0 .. batches-1, counted per scene.
@@ -319,10 +302,10 @@ TEST(MultiSceneData, SingleSceneManifestStaysVersion1AndLoadsAsOneScene) {
 TEST(MultiSceneData, MergeMixesDataSetsWithoutCopying) {
   const Renders& r = renders();
   const fs::path solo2 = r.root / "solo2";
-  ASSERT_EQ(cgsr("render --config " + tiny_config() + " --set name=solo --set frames=3 --out " + solo2.string()).code, 0);
+  ASSERT_EQ(run_cgsr("render --config " + tiny_config() + " --set name=solo --set frames=3 --out " + solo2.string()).exit_code, 0);
   const fs::path out = r.root / "merged";
-  const CliRun merge = cgsr("data merge " + r.set.string() + " " + solo2.string() + " --out " + out.string());
-  ASSERT_EQ(merge.code, 0) << merge.output;
+  const CliResult merge = run_cgsr("data merge " + r.set.string() + " " + solo2.string() + " --out " + out.string());
+  ASSERT_EQ(merge.exit_code, 0) << merge.all();
   const DatasetManifest m = read_manifest(out);
   ASSERT_EQ(m.scenes.size(), 3u);  // the set contributes its two scenes
   EXPECT_EQ(m.scenes[0].path, "../set/scenes/tiny");
@@ -333,7 +316,7 @@ TEST(MultiSceneData, MergeMixesDataSetsWithoutCopying) {
   EXPECT_EQ(data.frame_count(), 19);
   EXPECT_EQ(data.frames(Split::Test).back(), 16 + make_split(3).test.back());
   EXPECT_TRUE(torch::equal(data.frame(17, 0)->color, Dataset::open(solo2).frame(1, 0)->color));
-  EXPECT_EQ(cgsr("data check " + out.string()).code, 0);
+  EXPECT_EQ(run_cgsr("data check " + out.string()).exit_code, 0);
 
   // A source that changed after the merge is named when the merged set is opened.
   DatasetManifest changed = read_manifest(solo2);
@@ -350,33 +333,33 @@ TEST(MultiSceneData, MergeMixesDataSetsWithoutCopying) {
   write_manifest(solo2, original);
 
   // Two scenes of one name: both data sets are named.
-  const CliRun twice = cgsr("data merge " + r.set.string() + " " + r.solo.string() + " --out " + (r.root / "m2").string());
-  EXPECT_EQ(twice.code, 2) << twice.output;
-  EXPECT_NE(twice.output.find("two scenes are named 'tiny'"), std::string::npos) << twice.output;
-  EXPECT_NE(twice.output.find("solo"), std::string::npos) << twice.output;
+  const CliResult twice = run_cgsr("data merge " + r.set.string() + " " + r.solo.string() + " --out " + (r.root / "m2").string());
+  EXPECT_EQ(twice.exit_code, 2) << twice.all();
+  EXPECT_NE(twice.all().find("two scenes are named 'tiny'"), std::string::npos) << twice.all();
+  EXPECT_NE(twice.all().find("solo"), std::string::npos) << twice.all();
 }
 
 TEST(MultiSceneData, MergeRefusesOtherScales) {
   const Renders& r = renders();
   const fs::path x3 = r.root / "x3";
-  ASSERT_EQ(cgsr("render --config " + tiny_config() + " --set frames=2 --set resolutions=[64x48,192x144] --out " +
+  ASSERT_EQ(run_cgsr("render --config " + tiny_config() + " --set frames=2 --set resolutions=[64x48,192x144] --out " +
                  x3.string())
-                .code,
+                .exit_code,
             0);
-  const CliRun merge = cgsr("data merge " + r.solo.string() + " " + x3.string() + " --out " + (r.root / "m3").string());
-  EXPECT_EQ(merge.code, 2) << merge.output;
-  EXPECT_NE(merge.output.find(x3.string() + ": has resolutions 64x48, 192x144, but " + r.solo.string() +
+  const CliResult merge = run_cgsr("data merge " + r.solo.string() + " " + x3.string() + " --out " + (r.root / "m3").string());
+  EXPECT_EQ(merge.exit_code, 2) << merge.all();
+  EXPECT_NE(merge.all().find(x3.string() + ": has resolutions 64x48, 192x144, but " + r.solo.string() +
                               " has 64x48, 128x96"),
             std::string::npos)
-      << merge.output;
+      << merge.all();
   EXPECT_FALSE(has_manifest(r.root / "m3"));
 }
 
 TEST(MultiSceneData, EvalBySceneAndPerScene) {
   const Renders& r = renders();
   const fs::path all = r.root / "eval_all", one = r.root / "eval_b";
-  const CliRun a = cgsr("eval --data " + r.set.string() + " --model bicubic --latency-runs 0 --out " + all.string());
-  ASSERT_EQ(a.code, 0) << a.output;
+  const CliResult a = run_cgsr("eval --data " + r.set.string() + " --model bicubic --latency-runs 0 --out " + all.string());
+  ASSERT_EQ(a.exit_code, 0) << a.all();
   const auto ja = nlohmann::json::parse(read_text(all / "results.json"));
   const auto& scenes = ja["evaluations"][0]["scenes"];
   ASSERT_EQ(scenes.size(), 2u) << ja.dump(2);
@@ -384,9 +367,9 @@ TEST(MultiSceneData, EvalBySceneAndPerScene) {
   EXPECT_EQ(scenes[1]["scene"], "tiny_b");
   EXPECT_EQ(scenes[0]["frames"].get<int>() + scenes[1]["frames"].get<int>(), 2);  // a test frame per scene
 
-  const CliRun b = cgsr("eval --data " + r.set.string() + " --scene tiny_b --split val --model bicubic --latency-runs 0 --out " +
+  const CliResult b = run_cgsr("eval --data " + r.set.string() + " --scene tiny_b --split val --model bicubic --latency-runs 0 --out " +
                         one.string());
-  ASSERT_EQ(b.code, 0) << b.output;
+  ASSERT_EQ(b.exit_code, 0) << b.all();
   const auto jb = nlohmann::json::parse(read_text(one / "results.json"));
   EXPECT_EQ(jb["scene"], "tiny_b");
   const auto& frames = jb["evaluations"][0]["frames"];
@@ -398,10 +381,10 @@ TEST(MultiSceneData, EvalBySceneAndPerScene) {
 TEST(MultiSceneData, TrainsOnEveryScene) {
   const Renders& r = renders();
   const fs::path out = r.root / "train";
-  const CliRun train = cgsr("train --config " + std::string(CGSR_SOURCE_DIR) + "/configs/train/pan_x2.yaml --set data=" +
+  const CliResult train = run_cgsr("train --config " + std::string(CGSR_SOURCE_DIR) + "/configs/train/pan_x2.yaml --set data=" +
                             r.set.string() + " --steps 4 --set schedule.batch_size=2 --set schedule.patch_size=16 " +
                             "--set schedule.validate_every=4 --set schedule.val_frames=3 --threads 1 --out " + out.string());
-  ASSERT_EQ(train.code, 0) << train.output;
+  ASSERT_EQ(train.exit_code, 0) << train.all();
   EXPECT_NE(read_text(out / "log.txt").find("(11 train / 3 val frames)"), std::string::npos) << read_text(out / "log.txt");
   EXPECT_TRUE(fs::exists(out / "model.cgsr"));
 }

@@ -17,6 +17,7 @@ namespace cgsr::test {
 struct CliResult {
   int exit_code = -1;
   std::string out, err;
+  std::string all() const { return out + err; }  // for messages that may be on either stream
 };
 
 inline std::string slurp(const std::filesystem::path& path) {
