@@ -104,6 +104,19 @@ nlohmann::ordered_json sizes_json(const RenderJobResult& r) {
   return sizes;
 }
 
+// What every render reports, of one scene or a set.
+nlohmann::ordered_json render_summary(const std::filesystem::path& out, const DatasetManifest& manifest, int rendered,
+                                      int resumed, double seconds) {
+  nlohmann::ordered_json j;
+  j["dataset"] = out.string();
+  j["name"] = manifest.name;
+  j["frames"] = manifest.frames;
+  j["rendered"] = rendered;
+  j["resumed"] = resumed;
+  j["seconds"] = seconds;
+  return j;
+}
+
 nlohmann::ordered_json run_scene_set(const RenderOptions& options, const std::filesystem::path& out) {
   const auto jobs = scene_set_jobs(options);
   int total = 0;
@@ -112,13 +125,7 @@ nlohmann::ordered_json run_scene_set(const RenderOptions& options, const std::fi
   const SceneSetRenderResult r = run_scene_set_render(options.name, jobs, static_cast<uint64_t>(options.seed), out,
                                                       [&progress](int, int) { progress.advance(); });
   progress.finish();
-  nlohmann::ordered_json j;
-  j["dataset"] = out.string();
-  j["name"] = r.manifest.name;
-  j["frames"] = r.manifest.frames;
-  j["rendered"] = r.rendered;
-  j["resumed"] = r.skipped;
-  j["seconds"] = r.seconds;
+  nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
   j["scenes"] = nlohmann::ordered_json::array();
   std::printf("rendered %d frame(s) (%d resumed) of %zu scenes as '%s' into %s in %.1f s\n", r.rendered, r.skipped,
               r.scenes.size(), r.manifest.name.c_str(), out.string().c_str(), r.seconds);
@@ -150,13 +157,7 @@ nlohmann::ordered_json run_render(const RenderOptions& options, const std::files
   const RenderJobResult r = run_render_job(options, static_cast<uint64_t>(options.seed), out,
                                            [&progress](int, int) { progress.advance(); });
   progress.finish();
-  nlohmann::ordered_json j;
-  j["dataset"] = out.string();
-  j["name"] = r.manifest.name;
-  j["frames"] = r.manifest.frames;
-  j["rendered"] = r.rendered;
-  j["resumed"] = r.skipped;
-  j["seconds"] = r.seconds;
+  nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
   j["triangles"] = r.triangles;
   j["bytes_per_frame"] = sizes_json(r);
   std::printf("rendered %d frame(s) (%d resumed) of '%s' into %s in %.1f s\n", r.rendered, r.skipped,
