@@ -25,6 +25,8 @@ nlohmann::ordered_json run_heldout(const HeldoutOptions& options, const HeldoutJ
   std::set<std::string> names;
   for (size_t i = 0; i < options.scenes.size(); ++i) {
     RenderOptions scene = config::parse_document(config::Document::load_file(options.scenes[i]), render_schema());
+    if (!scene.scenes.empty())
+      throw Error(options.scenes[i], "is a scene set; list its scene configs under heldout.scenes one by one");
     scene.seed = job.seed;
     scene.threads = job.threads;
     scene.frames = options.frames;
