@@ -50,6 +50,18 @@ void flag_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const 
       description + " (config key '" + key + "')");
 }
 
+void list_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& name,
+                 const std::string& key, const std::string& description, const std::string& origin) {
+  sub.add_option_function<std::vector<std::string>>(
+      name,
+      [&assignments, key, origin](const std::vector<std::string>& values) {
+        std::string list = "[";
+        for (size_t i = 0; i < values.size(); ++i) list += (i ? ", " : "") + ("'" + values[i] + "'");
+        assignments.push_back({key + "=" + list + "]", origin});
+      },
+      description);
+}
+
 void switch_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
                    const std::string& key, const std::string& description) {
   sub.add_flag_function(

@@ -94,6 +94,10 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
 // Adds `--name VALUE` to `sub`, recorded as the assignment "key=VALUE".
 void flag_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
                  const std::string& key, const std::string& description);
+// Adds a repeatable option or positional list `name` to `sub`, recorded as the assignment
+// "key=['a', 'b']" (quoted, so paths stay strings) with `origin` as where it came from.
+void list_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& name,
+                 const std::string& key, const std::string& description, const std::string& origin);
 // Adds a boolean `--name` flag to `sub`, recorded as "key=true".
 void switch_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
                    const std::string& key, const std::string& description);

@@ -30,14 +30,7 @@ void setup_data_merge(CLI::App& data) {
       data, "merge", "One multi-scene data set from existing data sets (a manifest that refers to them, no copies)",
       data_merge_schema,
       [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        sub.add_option_function<std::vector<std::string>>(
-            "data",
-            [&flags](const std::vector<std::string>& dirs) {
-              std::string list = "[";
-              for (size_t i = 0; i < dirs.size(); ++i) list += (i ? ", " : "") + ("'" + dirs[i] + "'");
-              flags.push_back({"data=" + list + "]", "DATA"});
-            },
-            "data set directories");
+        list_to_key(sub, flags, "data", "data", "data set directories", "DATA");
       },
       [](const DataMergeOptions& options, const YAML::Node&, RunDir* run_dir) {
         return run_data_merge(options, run_dir->path());

@@ -48,14 +48,8 @@ void setup_eval(CLI::App& app) {
       app, "eval", "Evaluate models and classic upscalers: PSNR, SSIM, temporal error, latency", eval_schema,
       [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
         flag_to_key(sub, flags, "--data", "data", "data set directory");
-        sub.add_option_function<std::vector<std::string>>(
-            "--model",
-            [&flags](const std::vector<std::string>& models) {
-              std::string list = "[";
-              for (size_t i = 0; i < models.size(); ++i) list += (i ? ", " : "") + ("'" + models[i] + "'");
-              flags.push_back({"models=" + list + "]", "--model"});
-            },
-            "model file or classic upscaler name (repeatable; 'classic' = all classic upscalers)");
+        list_to_key(sub, flags, "--model", "models",
+                    "model file or classic upscaler name (repeatable; 'classic' = all classic upscalers)", "--model");
         flag_to_key(sub, flags, "--scene", "scene", "one scene of a multi-scene data set");
         flag_to_key(sub, flags, "--split", "eval.split", "data set split");
         flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");

@@ -40,14 +40,7 @@ void setup_report(CLI::App& app) {
   add_command<ReportOptions>(
       app, "report", "Tabulate and plot evaluations: quality against params, MACs and latency", report_schema,
       [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        sub.add_option_function<std::vector<std::string>>(
-            "runs",
-            [&flags](const std::vector<std::string>& runs) {
-              std::string list = "[";
-              for (size_t i = 0; i < runs.size(); ++i) list += (i ? ", " : "") + ("'" + runs[i] + "'");
-              flags.push_back({"runs=" + list + "]", "RUN_DIRS"});
-            },
-            "run directories or results.json files");
+        list_to_key(sub, flags, "runs", "runs", "run directories or results.json files", "RUN_DIRS");
       },
       [](const ReportOptions& options, const YAML::Node&, RunDir* run_dir) { return run_report(options, *run_dir); },
       /*always_run_dir=*/true);
