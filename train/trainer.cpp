@@ -59,6 +59,10 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
   j["patches_per_second"] = o.patches_per_second;
   j["resumed"] = o.resumed;
   j["layout"] = o.layout;
+  const StepPhases& p = o.phase_ms;
+  j["phase_ms"] = {{"batch", p.batch},         {"forward_and_loss", p.forward_and_loss},
+                   {"backward_and_clip", p.backward_and_clip}, {"optimizer", p.optimizer},
+                   {"validation", p.validation}, {"checkpoint", p.checkpoint}};
   j["best"] = score(o.best);
   j["last"] = score(o.last);
   j["history"] = nlohmann::ordered_json::array();
@@ -332,8 +336,17 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   network_->train();
   Progress progress("train", schedule_.steps, step);
   int consecutive_bad = 0;
-  const auto started = std::chrono::steady_clock::now();
+  using Clock = std::chrono::steady_clock;
+  const auto started = Clock::now();
   const int first_step = step;
+  // Seconds per phase, summed over the steps; `lap` adds the time since the previous lap.
+  StepPhases spent;
+  auto lap_start = Clock::now();
+  const auto lap = [&](double& phase) {
+    const auto now = Clock::now();
+    phase += std::chrono::duration<double>(now - lap_start).count();
+    lap_start = now;
+  };
   while (step < schedule_.steps) {
     const double lr = learning_rate(step);
     for (size_t g = 0; g < optimizer_->param_groups().size(); ++g)
@@ -341,17 +354,21 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
           .lr(g == 1 ? lr * schedule_.rit_lr_scale : lr);
 
     // Batches are a function of the step, so a resumed run sees the same data.
+    lap_start = Clock::now();
     const Batch batch = in_layout(sampler.batch(step), layout_);
+    lap(spent.batch);
     const auto output = forward(batch, step);
     LossTerms terms = cgsr_loss(*network_, output, batch, loss_, shrink_);
     if (hooks_.extra_loss) terms.total = terms.total + hooks_.extra_loss(batch, output, step);
     optimizer_->zero_grad();
     bool finite = std::isfinite(terms.total.item<double>());
+    lap(spent.forward_and_loss);
     if (finite) {
       terms.total.backward();
       const double limit = schedule_.clip_grad_norm > 0 ? schedule_.clip_grad_norm : INFINITY;
       finite = std::isfinite(torch::nn::utils::clip_grad_norm_(params, limit));
     }
+    lap(spent.backward_and_clip);
     if (finite) {
       optimizer_->step();
       consecutive_bad = 0;
@@ -364,6 +381,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
                              "at step " + std::to_string(step) + " (learning rate " + std::to_string(lr) +
                              "); lower schedule.lr_max");
     }
+    lap(spent.optimizer);
     ++step;
     progress.set_status("loss " + std::to_string(terms.image).substr(0, 8) + " lr " + std::to_string(lr).substr(0, 8));
     progress.advance();
@@ -379,8 +397,12 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
       }
       spdlog::info("step {}: validation PSNR {:.3f} dB, SSIM {:.4f} (best {:.3f} at step {})", step, score.psnr,
                    score.ssim, outcome.best.psnr, outcome.best.step);
+      lap(spent.validation);
     }
-    if (checkpoint && (step % schedule_.checkpoint_every == 0 || last)) save_checkpoint(*checkpoint, step, outcome);
+    if (checkpoint && (step % schedule_.checkpoint_every == 0 || last)) {
+      save_checkpoint(*checkpoint, step, outcome);
+      lap(spent.checkpoint);
+    }
   }
   progress.finish();
   // A run can end before max_nonfinite_steps skipped steps in a row with weights whose outputs
@@ -391,6 +413,10 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
                              ", geometry " + std::to_string(outcome.best.geometry_loss) + ") after " +
                              std::to_string(outcome.skipped_steps) + " skipped non-finite steps; lower schedule.lr_max");
   outcome.steps = step;
+  const double ms_per_step = step > first_step ? 1e3 / (step - first_step) : 0;
+  for (double StepPhases::*phase : {&StepPhases::batch, &StepPhases::forward_and_loss, &StepPhases::backward_and_clip,
+                                    &StepPhases::optimizer, &StepPhases::validation, &StepPhases::checkpoint})
+    outcome.phase_ms.*phase = spent.*phase * ms_per_step;
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   outcome.patches_per_second =
       outcome.seconds > 0 ? (step - first_step) * static_cast<double>(schedule_.batch_size) / outcome.seconds : 0;

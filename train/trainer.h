@@ -52,6 +52,13 @@ struct ValidationScore {
   double image_loss = 0, geometry_loss = 0;  // the joint loss terms on full frames
 };
 
+// Where the wall time of a run's steps went, in milliseconds per step (the same phases as
+// bench/bench_training_step, plus waiting for the batch and the periodic work), so a slow stage
+// says whether data, compute or bookkeeping is the cause.
+struct StepPhases {
+  double batch = 0, forward_and_loss = 0, backward_and_clip = 0, optimizer = 0, validation = 0, checkpoint = 0;
+};
+
 struct TrainOutcome {
   int steps = 0;
   int skipped_steps = 0;
@@ -61,6 +68,7 @@ struct TrainOutcome {
   std::vector<ValidationScore> history;
   bool resumed = false;
   std::string layout;  // the memory layout the steps ran in
+  StepPhases phase_ms;  // over the steps this run took (a resumed run: since the resume)
 };
 nlohmann::ordered_json to_json(const TrainOutcome& outcome);
 
