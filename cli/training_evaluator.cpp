@@ -8,6 +8,8 @@
 #include "core/hash.h"
 #include "core/runtime.h"
 #include "core/timing.h"
+#include "models/backbone_registry.h"
+#include "models/block_importance.h"
 #include "models/complexity.h"
 #include "models/inference.h"
 #include "models/inherit.h"
@@ -33,8 +35,9 @@ namespace {
 uint64_t text_hash(const std::string& text) { return fnv1a64(text, kLegacyFnv1a64Basis); }
 }  // namespace
 
-TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options)
-    : parent_(std::move(parent)), data_(data), options_(std::move(options)) {
+TrainingEvaluator::TrainingEvaluator(SRNetwork parent, const Dataset& data, CandidateTraining options,
+                                     std::vector<int> drop_order)
+    : parent_(std::move(parent)), data_(data), options_(std::move(options)), drop_order_(std::move(drop_order)) {
   const auto val = data_.frames(Split::Val).empty() ? data_.frames(Split::Train) : data_.frames(Split::Val);
   const Batch b = frame_batch(data_, val.front(), parent_->spec().scale, {}, DepthEncoding::Log);
   lr_width_ = b.lr_color.size(3);
@@ -64,6 +67,10 @@ CandidateScore TrainingEvaluator::score(SRNetwork network, const ValidationScore
   return s;
 }
 
+std::vector<int> TrainingEvaluator::parent_blocks(const ArchSpec& spec) const {
+  return drop_order_.empty() ? std::vector<int>{} : kept_blocks(drop_order_, resolve_spec(spec).blocks);
+}
+
 // The parent as a candidate equal to itself: faded (with nothing to fade), copied and trained
 // like any candidate. Validated untrained, it scored below candidates that had trained more, and
 // the pick rule compared unlike things.
@@ -73,19 +80,22 @@ CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
   const auto started = std::chrono::steady_clock::now();
   torch::manual_seed(global_seed() ^ text_hash(SearchSpace::key(spec)));
 
+  const auto blocks = parent_blocks(spec);
   SRNetwork base = parent_;
   if (options_.fade_steps > 0) {
     // Fade on a copy of the parent (a child equal to its parent is a bit-identical copy).
     SRNetwork faded = inherit(*parent_, parent_->spec()).network;
+    // Every channel the candidate drops fades: those of the groups it narrows, and all of
+    // those of the blocks it drops (groups it does not keep at all).
     ShrinkTargets shrink;
-    const auto kept = inherit(*parent_, spec).kept;
-    const auto importance = parent_->channel_importance();
-    for (const auto& [group, keep] : kept) {
-      const auto it = importance.find(group);
-      if (it == importance.end()) continue;
+    const auto kept = inherit(*parent_, spec, {}, blocks).kept;
+    for (const auto& [group, importance] : parent_->channel_importance()) {
+      const auto keep = kept.find(group);
+      if (keep == kept.end() && !parse_block_group(group)) continue;  // a group the candidate keeps whole
       std::vector<int64_t> dropped;
-      for (int64_t c = 0; c < it->second.size(0); ++c)
-        if (std::find(keep.begin(), keep.end(), c) == keep.end()) dropped.push_back(c);
+      for (int64_t c = 0; c < importance.size(0); ++c)
+        if (keep == kept.end() || std::find(keep->second.begin(), keep->second.end(), c) == keep->second.end())
+          dropped.push_back(c);
       if (!dropped.empty()) shrink[group] = dropped;
     }
     TrainSchedule fade = options_.schedule;
@@ -95,7 +105,7 @@ CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
     Trainer(faded, data_, fade, options_.loss, shrink).run();
     base = faded;
   }
-  SRNetwork child = inherit(*base, spec).network;
+  SRNetwork child = inherit(*base, spec, {}, blocks).network;
   Trainer trainer(child, data_, options_.schedule, options_.loss);
   const TrainOutcome outcome = trainer.run();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

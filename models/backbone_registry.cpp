@@ -1,5 +1,7 @@
 #include "models/backbone_registry.h"
 
+#include <cctype>
+
 #include "models/backbones/edsr.h"
 #include "models/backbones/pan.h"
 #include "models/backbones/srcnn.h"
@@ -23,6 +25,17 @@ void register_builtin_backbones(Registry<BackboneInfo>& registry) {
 
 std::string block_group(int block, const std::string& suffix) {
   return "block" + std::to_string(block) + "_" + suffix;
+}
+
+std::optional<std::pair<int, std::string>> parse_block_group(const std::string& name) {
+  static const std::string prefix = "block";
+  if (name.rfind(prefix, 0) != 0) return std::nullopt;
+  size_t pos = prefix.size();
+  int block = 0;
+  while (pos < name.size() && std::isdigit(static_cast<unsigned char>(name[pos])) && block < 100000)
+    block = block * 10 + (name[pos++] - '0');
+  if (pos == prefix.size() || pos >= name.size() || name[pos] != '_') return std::nullopt;
+  return std::make_pair(block, name.substr(pos + 1));
 }
 
 }  // namespace cgsr

@@ -4,7 +4,9 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/registry.h"
@@ -37,5 +39,7 @@ void register_builtin_backbones(Registry<BackboneInfo>& registry);
 
 // "block3_a"
 std::string block_group(int block, const std::string& suffix);
+// The inverse: (block, suffix) of a name block_group made, nothing for other group names.
+std::optional<std::pair<int, std::string>> parse_block_group(const std::string& name);
 
 }  // namespace cgsr

@@ -3,15 +3,60 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cctype>
 #include <numeric>
 #include <set>
 
 #include "core/error.h"
 #include "core/text.h"
+#include "models/backbone_registry.h"
 
 namespace cgsr {
 
-std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child) {
+namespace {
+
+// Child names -> parent names when child block i is parent block blocks[i] (empty: block i).
+class BlockMap {
+ public:
+  explicit BlockMap(std::vector<int> blocks) : blocks_(std::move(blocks)) {}
+
+  // "block<i>_<suffix>" -> "block<blocks[i]>_<suffix>"; other groups unchanged.
+  std::string group(const std::string& name) const {
+    const auto block = parse_block_group(name);
+    if (!block || !mapped(block->first)) return name;
+    return block_group(blocks_[block->first], block->second);
+  }
+  // "backbone.blocks.<i>.rest" -> "backbone.blocks.<blocks[i]>.rest"; other ops unchanged.
+  std::string op(const std::string& name) const {
+    static const std::string prefix = "backbone.blocks.";
+    if (name.rfind(prefix, 0) != 0) return name;
+    const size_t dot = name.find('.', prefix.size());
+    if (dot == std::string::npos) return name;
+    const std::string index = name.substr(prefix.size(), dot - prefix.size());
+    if (index.empty() || index.size() > 6 || !std::all_of(index.begin(), index.end(), [](unsigned char c) { return std::isdigit(c); })) return name;
+    const int i = std::stoi(index);
+    return mapped(i) ? prefix + std::to_string(blocks_[i]) + name.substr(dot) : name;
+  }
+
+ private:
+  bool mapped(int i) const { return i >= 0 && i < static_cast<int>(blocks_.size()); }
+  std::vector<int> blocks_;
+};
+
+void check_block_map(const ArchSpec& parent, const ArchSpec& child, const std::vector<int>& blocks) {
+  if (blocks.empty()) return;
+  CGSR_CHECK(static_cast<int>(blocks.size()) == child.blocks,
+             "inherit: " + std::to_string(blocks.size()) + " parent blocks chosen for a child of " +
+                 std::to_string(child.blocks));
+  for (size_t i = 0; i < blocks.size(); ++i)
+    CGSR_CHECK(blocks[i] >= 0 && blocks[i] < parent.blocks && (i == 0 || blocks[i] > blocks[i - 1]),
+               "inherit: the parent blocks of a child must be ascending parent block indices");
+}
+
+}  // namespace
+
+std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child,
+                                              const std::vector<int>& parent_blocks) {
   std::vector<std::string> p;
   if (child.backbone != parent.backbone)
     p.push_back("backbone " + child.backbone + " differs from the parent's " + parent.backbone);
@@ -22,10 +67,15 @@ std::vector<std::string> inheritance_problems(const ArchSpec& parent, const Arch
   if (child.blocks > parent.blocks)
     p.push_back("child has " + std::to_string(child.blocks) + " blocks, the parent only " +
                 std::to_string(parent.blocks));
-  for (const auto& [group, width] : child.widths.entries())
-    if (parent.widths.contains(group) && width > parent.widths.at(group))
-      p.push_back("layer group " + group + " is " + std::to_string(width) + " wide, the parent's only " +
-                  std::to_string(parent.widths.at(group)));
+  if (!p.empty()) return p;
+  check_block_map(parent, child, parent_blocks);
+  const BlockMap map(parent_blocks);
+  for (const auto& [group, width] : child.widths.entries()) {
+    const std::string in_parent = map.group(group);
+    if (parent.widths.contains(in_parent) && width > parent.widths.at(in_parent))
+      p.push_back("layer group " + group + " is " + std::to_string(width) + " wide, the parent's " +
+                  (in_parent == group ? "" : in_parent + " ") + "only " + std::to_string(parent.widths.at(in_parent)));
+  }
   if (child.rit.enabled && parent.rit.enabled) {
     if (child.rit.source != parent.rit.source)
       p.push_back("rit.source " + child.rit.source + " differs from the parent's " + parent.rit.source);
@@ -54,13 +104,15 @@ namespace {
 
 // Positions along a parent axis that make up the child axis, in child order.
 std::vector<int64_t> axis_indices(const graph::Layout& parent, const graph::Layout& child,
-                                  const std::map<std::string, std::vector<int64_t>>& kept, const std::string& what) {
+                                  const std::map<std::string, std::vector<int64_t>>& kept, const BlockMap& map,
+                                  const std::string& what) {
   std::vector<int64_t> out;
   for (const auto& cs : child) {
+    const std::string group = map.group(cs.group);
     int64_t offset = 0;
     const graph::Segment* ps = nullptr;
     for (const auto& s : parent) {
-      if (s.group == cs.group) {
+      if (s.group == group) {
         ps = &s;
         break;
       }
@@ -70,7 +122,7 @@ std::vector<int64_t> axis_indices(const graph::Layout& parent, const graph::Layo
                "inherit: " + what + ": channel group " + cs.group + " has no counterpart in the parent");
     std::vector<int64_t> channels;
     if (cs.prunable) {
-      channels = kept.at(cs.group);
+      channels = kept.at(group);
     } else {
       CGSR_CHECK(ps->channels == cs.channels, "inherit: " + what + ": fixed axis " + cs.group + " changed size");
       channels.resize(cs.channels);
@@ -87,15 +139,17 @@ torch::Tensor take(const torch::Tensor& t, int64_t dim, const std::vector<int64_
   return t.index_select(dim, torch::tensor(index, torch::kLong));
 }
 
-// The channels of each group to keep: all of them when the width is unchanged (so an identical
-// child is an exact copy), else the most important ones in their original order.
+// The channels of each group to keep, by the parent's group names: all of them when the width is
+// unchanged (so an identical child is an exact copy), else the most important ones in their
+// original order.
 std::map<std::string, std::vector<int64_t>> choose_channels(const graph::Graph& parent, const graph::Graph& child,
-                                                            const std::map<std::string, std::vector<int64_t>>& given) {
+                                                            const std::map<std::string, std::vector<int64_t>>& given,
+                                                            const BlockMap& map) {
   const auto importance = channel_importance(parent);
-  std::map<std::string, int64_t> child_widths;
+  std::map<std::string, int64_t> child_widths;  // by parent group name
   for (const auto& v : child.values)
     for (const auto& s : v.layout)
-      if (s.prunable) child_widths[s.group] = s.channels;
+      if (s.prunable) child_widths[map.group(s.group)] = s.channels;
   std::map<std::string, std::vector<int64_t>> kept;
   for (const auto& [group, width] : child_widths) {
     const auto it = importance.find(group);
@@ -136,9 +190,9 @@ bool fresh_allowed(const std::string& name) { return name.rfind("rit.", 0) == 0 
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec) { return inherit(parent, child_spec, {}); }
 
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
-                    const std::map<std::string, std::vector<int64_t>>& kept) {
+                    const std::map<std::string, std::vector<int64_t>>& kept, const std::vector<int>& parent_blocks) {
   const ArchSpec child_spec = resolve_spec(child_spec_in);
-  const auto problems = inheritance_problems(parent.spec(), child_spec);
+  const auto problems = inheritance_problems(parent.spec(), child_spec, parent_blocks);
   if (!problems.empty())
     throw Error("inherit " + spec_summary(child_spec) + " from " + spec_summary(parent.spec()), join(problems, "; "));
 
@@ -146,10 +200,12 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
   result.network = SRNetwork(child_spec);
   const graph::Graph pg = parent.describe(/*training=*/true);
   const graph::Graph cg = result.network->describe(/*training=*/true);
+  const BlockMap map(parent_blocks);
+  std::set<std::string> child_groups = {"rit", "rit_hr", "geometry"};  // by parent group name
+  for (const auto& [group, width] : child_spec.widths.entries()) child_groups.insert(map.group(group));
   for (const auto& [group, channels] : kept)
-    CGSR_CHECK(child_spec.widths.contains(group) || group == "rit" || group == "rit_hr" || group == "geometry",
-               "inherit: chosen channels for an unknown layer group " + group);
-  result.kept = choose_channels(pg, cg, kept);
+    CGSR_CHECK(child_groups.count(group), "inherit: chosen channels for an unknown layer group " + group);
+  result.kept = choose_channels(pg, cg, kept, map);
 
   torch::NoGradGuard no_grad;
   std::set<const void*> assigned;
@@ -160,17 +216,17 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
   };
   for (const auto& op : cg.ops) {
     if (!op.trainable || (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine)) continue;
-    const graph::Op* pop = pg.find_op(op.name);
+    const graph::Op* pop = pg.find_op(map.op(op.name));
     if (!pop) {
       CGSR_CHECK(fresh_allowed(op.name), "inherit: the parent has no " + op.name);
       continue;
     }
-    const auto out = axis_indices(pg.values[pop->output].layout, cg.values[op.output].layout, result.kept,
+    const auto out = axis_indices(pg.values[pop->output].layout, cg.values[op.output].layout, result.kept, map,
                                   op.name + " output");
     if (op.kind == graph::OpKind::Conv) {
       CGSR_CHECK(op.groups == 1 && pop->groups == 1, "inherit: grouped convs are not supported");
       const auto in = axis_indices(pg.values[pop->inputs[0]].layout, cg.values[op.inputs[0]].layout, result.kept,
-                                   op.name + " input");
+                                   map, op.name + " input");
       copy(op.weight, take(take(pop->weight, 0, out), 1, in), op.name + ".weight");
       if (op.bias.defined()) copy(op.bias, take(pop->bias, 0, out), op.name + ".bias");
     } else {

@@ -6,7 +6,8 @@
 // every tensor through the graph layouts: a channel removed from a residual stream is removed
 // from every layer writing into or reading from it, both operands of an attention product lose
 // the same channels, and a pixel-shuffle group keeps or drops all r*r sub-channels together.
-// Block i of the child inherits block i of the parent (a child may have fewer blocks).
+// Block i of the child inherits block i of the parent (a child may have fewer blocks), or the
+// parent block the caller names (block_importance.h: the search drops the least important).
 //
 // Parts the parent lacks start fresh: a RIT (its fusion is zero, so the output equals the
 // parent's exactly) and the geometry head. The child's RIT may read a subset of the parent's
@@ -26,7 +27,9 @@ namespace cgsr {
 
 struct Inheritance {
   SRNetwork network{nullptr};
-  std::map<std::string, std::vector<int64_t>> kept;  // layer group -> parent channel indices kept
+  // The parent's layer group -> its channel indices kept (a child block's groups appear under
+  // the name of the parent block it inherits).
+  std::map<std::string, std::vector<int64_t>> kept;
   std::vector<std::string> fresh;                    // parameters that start from initialization
 };
 
@@ -35,11 +38,15 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec);
 // The same with the channels of some groups chosen by the caller (pruning): `kept[group]` lists
 // distinct parent channel indices in the child's channel order, as many as the child's width of
 // that group (a permutation of a same-width group reorders its channels). Groups not listed are
-// chosen by importance as above.
+// chosen by importance as above. `parent_blocks` (ascending, one per child block) names the
+// parent block each child block inherits; empty: the first child.blocks blocks.
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec,
-                    const std::map<std::string, std::vector<int64_t>>& kept);
+                    const std::map<std::string, std::vector<int64_t>>& kept,
+                    const std::vector<int>& parent_blocks = {});
 
-// The child spec's problems with `parent` (empty when inheritance is possible).
-std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child);
+// The child spec's problems with `parent` (empty when inheritance is possible), with child block
+// i compared to parent block parent_blocks[i] (empty: block i).
+std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child,
+                                              const std::vector<int>& parent_blocks = {});
 
 }  // namespace cgsr

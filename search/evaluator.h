@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <vector>
 
 #include "models/arch_spec.h"
 
@@ -30,6 +31,9 @@ class Evaluator {
   // The parent itself, given exactly a candidate's treatment (same training, same validation),
   // so the pick rule compares like with like.
   virtual CandidateScore evaluate_parent() = 0;
+  // The parent's blocks, least important first (models/block_importance.h): the order in which
+  // shallower candidates drop them. Empty: the last block first.
+  virtual std::vector<int> block_drop_order() const { return {}; }
 };
 
 }  // namespace cgsr

@@ -58,7 +58,7 @@ std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates) {
 
 SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
                         const SearchOptions& options) {
-  const SearchSpace space(parent_spec, options.space);
+  const SearchSpace space(parent_spec, options.space, evaluator.block_drop_order());
   auto strategy = strategy_registry().get(options.strategy)(space, options.operators);
   SearchResult result;
 

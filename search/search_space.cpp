@@ -2,12 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/error.h"
 #include "models/backbone_registry.h"
+#include "models/block_importance.h"
 #include "models/inherit.h"
 
 namespace cgsr {
+
+const std::vector<std::string>& EnumNames<BlockDrop>::names() {
+  static const std::vector<std::string> n{"importance", "trailing"};
+  return n;
+}
 
 config::Schema<SearchSpaceOptions> search_space_schema() {
   config::Schema<SearchSpaceOptions> s;
@@ -18,11 +25,47 @@ config::Schema<SearchSpaceOptions> search_space_schema() {
   s.field("search_blocks", &SearchSpaceOptions::search_blocks, "vary the number of blocks");
   s.field("search_rit_channels", &SearchSpaceOptions::search_rit_channels, "vary the RIT's rendering channels");
   s.field("search_rit_width", &SearchSpaceOptions::search_rit_width, "vary the RIT's width");
+  s.field("drop_blocks", &SearchSpaceOptions::drop_blocks,
+          "blocks a shallower candidate drops: the parent's least important, or its last ones");
   return s;
 }
 
-SearchSpace::SearchSpace(ArchSpec parent, SearchSpaceOptions options)
-    : parent_(resolve_spec(std::move(parent))), options_(options) {}
+SearchSpace::SearchSpace(ArchSpec parent, SearchSpaceOptions options, std::vector<int> drop_order)
+    : parent_(resolve_spec(std::move(parent))), options_(options), drop_order_(std::move(drop_order)) {
+  const int blocks = std::max(0, parent_.blocks);
+  if (options_.drop_blocks == BlockDrop::Trailing || drop_order_.empty()) {
+    drop_order_.clear();
+    for (int b = blocks - 1; b >= 0; --b) drop_order_.push_back(b);
+  }
+  std::vector<int> sorted = drop_order_;
+  std::sort(sorted.begin(), sorted.end());
+  for (int b = 0; b < static_cast<int>(sorted.size()); ++b)
+    CGSR_CHECK(sorted[b] == b && static_cast<int>(sorted.size()) == blocks,
+               "SearchSpace: the block drop order must list each of the parent's " + std::to_string(blocks) +
+                   " blocks once");
+}
+
+std::vector<int> SearchSpace::parent_blocks(const ArchSpec& spec) const {
+  return kept_blocks(drop_order_, std::max(0, resolve_spec(spec).blocks));
+}
+
+std::string SearchSpace::parent_group(const ArchSpec& spec, const std::string& group) const {
+  const auto block = parse_block_group(group);
+  return block ? block_group(parent_blocks(spec).at(block->first), block->second) : group;
+}
+
+int SearchSpace::parent_width(const ArchSpec& spec, const std::string& group) const {
+  return parent_.widths.at(parent_group(spec, group));
+}
+
+std::map<std::string, int> SearchSpace::block_genes(const ArchSpec& spec) const {
+  std::map<std::string, int> genes;
+  const auto kept = parent_blocks(spec);
+  for (const auto& [group, width] : spec.widths.entries())
+    if (const auto block = parse_block_group(group); block && block->first < static_cast<int>(kept.size()))
+      genes[block_group(kept[block->first], block->second)] = width;
+  return genes;
+}
 
 std::vector<int> SearchSpace::width_choices(int parent_width) const {
   const int lowest = std::max(1, static_cast<int>(std::ceil(options_.min_width_fraction * parent_width)));
@@ -39,13 +82,23 @@ int SearchSpace::min_blocks() const {
 }
 
 ArchSpec SearchSpace::with_blocks(const ArchSpec& spec, int blocks) const {
+  const auto genes = block_genes(spec);
+  const auto kept = kept_blocks(drop_order_, blocks);
   ArchSpec out = spec;
   out.blocks = blocks;
   out.widths = GroupWidths();
   const auto& info = backbone_registry().get(parent_.backbone);
-  for (const auto& group : info.groups(parent_.scale, blocks))
-    out.widths.set(group.name, spec.widths.contains(group.name) ? spec.widths.at(group.name)
-                                                                : parent_.widths.at(group.name));
+  for (const auto& group : info.groups(parent_.scale, blocks)) {
+    // A block group of block i takes the gene of the parent block it keeps, or that block's width.
+    if (const auto block = parse_block_group(group.name)) {
+      const std::string in_parent = block_group(kept.at(block->first), block->second);
+      const auto gene = genes.find(in_parent);
+      out.widths.set(group.name, gene != genes.end() ? gene->second : parent_.widths.at(in_parent));
+    } else {
+      out.widths.set(group.name, spec.widths.contains(group.name) ? spec.widths.at(group.name)
+                                                                  : parent_.widths.at(group.name));
+    }
+  }
   return out;
 }
 
@@ -73,7 +126,7 @@ ArchSpec SearchSpace::mutate(const ArchSpec& spec, double rate, std::mt19937_64&
   }
   GroupWidths widths;
   for (const auto& [group, width] : out.widths.entries())
-    widths.set(group, u(rng) < rate ? mutate_choice(width_choices(parent_.widths.at(group)), width, rng) : width);
+    widths.set(group, u(rng) < rate ? mutate_choice(width_choices(parent_width(out, group)), width, rng) : width);
   out.widths = widths;
   if (parent_.rit.enabled) {
     if (options_.search_rit_width && u(rng) < rate)
@@ -97,10 +150,19 @@ ArchSpec SearchSpace::mutate(const ArchSpec& spec, double rate, std::mt19937_64&
 ArchSpec SearchSpace::crossover(const ArchSpec& a, const ArchSpec& b, std::mt19937_64& rng) const {
   std::bernoulli_distribution coin(0.5);
   ArchSpec out = with_blocks(a, coin(rng) ? a.blocks : b.blocks);
+  // Block genes cross by the parent block they belong to.
+  const auto b_genes = block_genes(b);
+  const auto kept = parent_blocks(out);
   GroupWidths widths;
   for (const auto& [group, width] : out.widths.entries()) {
-    const bool from_b = b.widths.contains(group) && coin(rng);
-    widths.set(group, from_b ? b.widths.at(group) : width);
+    std::optional<int> from_b;
+    if (const auto block = parse_block_group(group)) {
+      const auto gene = b_genes.find(block_group(kept.at(block->first), block->second));
+      if (gene != b_genes.end()) from_b = gene->second;
+    } else if (b.widths.contains(group)) {
+      from_b = b.widths.at(group);
+    }
+    widths.set(group, from_b && coin(rng) ? *from_b : width);
   }
   out.widths = widths;
   if (parent_.rit.enabled) {
@@ -124,7 +186,7 @@ ArchSpec SearchSpace::sample(std::mt19937_64& rng) const {
   if (options_.search_blocks && parent_.blocks > 0)
     out = with_blocks(out, std::uniform_int_distribution<int>(min_blocks(), parent_.blocks)(rng));
   GroupWidths widths;
-  for (const auto& [group, width] : out.widths.entries()) widths.set(group, any(width_choices(parent_.widths.at(group))));
+  for (const auto& [group, width] : out.widths.entries()) widths.set(group, any(width_choices(parent_width(out, group))));
   out.widths = widths;
   if (parent_.rit.enabled) {
     if (options_.search_rit_width) out.rit.width = any(width_choices(parent_.rit.width));
@@ -148,10 +210,11 @@ bool SearchSpace::contains(const ArchSpec& spec) const {
   } catch (const Error&) {
     return false;
   }
-  if (!inheritance_problems(parent_, spec).empty()) return false;
+  if (spec.blocks > parent_.blocks || !inheritance_problems(parent_, spec, parent_blocks(spec)).empty()) return false;
   for (const auto& [group, width] : spec.widths.entries()) {
-    if (!parent_.widths.contains(group)) return false;
-    const auto choices = width_choices(parent_.widths.at(group));
+    const std::string in_parent = parent_group(spec, group);
+    if (!parent_.widths.contains(in_parent)) return false;
+    const auto choices = width_choices(parent_.widths.at(in_parent));
     if (std::find(choices.begin(), choices.end(), width) == choices.end()) return false;
   }
   return true;

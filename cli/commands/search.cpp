@@ -1,9 +1,11 @@
 #include "cli/commands/search.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "core/plot.h"
 #include "core/yaml_json.h"
+#include "models/block_importance.h"
 #include "models/inherit.h"
 #include "models/model_file.h"
 #include "render_data/dataset.h"
@@ -64,14 +66,20 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
     spdlog::warn("{}: the parent has no RIT block; the search runs on the plain backbone", options.parent);
 
   SearchHistory history(run_dir.file("history.jsonl"), options.resume);
-  TrainingEvaluator evaluator(parent.network, data, options.candidate);
+  std::vector<int> drop_order;
+  if (options.search.space.drop_blocks == BlockDrop::Importance && parent.network->spec().blocks > 0) {
+    drop_order = block_drop_order(*parent.network);
+    spdlog::info("search: shallower candidates drop the parent's blocks in the order {} (least important first)",
+                 fmt::join(drop_order, ", "));
+  }
+  TrainingEvaluator evaluator(parent.network, data, options.candidate, drop_order);
   const SearchResult result = run_search(parent.network->spec(), evaluator, history, options.search);
   write_population_plot(run_dir.file("population.png"), result);
   if (result.pick_is_parent)
     spdlog::warn("no candidate stayed within {} dB of the parent; the parent is kept", options.search.tolerance_db);
 
   // The CG-optimized network: the pick, inherited from the parent and trained longer.
-  SRNetwork picked = inherit(*parent.network, result.pick.spec).network;
+  SRNetwork picked = inherit(*parent.network, result.pick.spec, {}, evaluator.parent_blocks(result.pick.spec)).network;
   Trainer trainer(picked, data, options.final_schedule, options.candidate.loss);
   const TrainOutcome final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
 

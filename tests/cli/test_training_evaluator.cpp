@@ -1,5 +1,5 @@
 // The search's real evaluator (cli/training_evaluator.h) on the tiny scene: fade, inheritance
-// and training of a candidate give a finite score, and the parent is scored as the candidate
+// (of the blocks the parent's block importance spares) and training of a candidate give a finite score, and the parent is scored as the candidate
 // equal to it, so the pick rule compares networks that trained alike.
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include "cli/training_evaluator.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
+#include "models/block_importance.h"
 #include "search/search_space.h"
 #include "tests/support/tiny_data.h"
 
@@ -36,15 +37,17 @@ TEST(TrainingEvaluator, TheParentIsScoredAsTheCandidateEqualToIt) {
   seed_everything(5);
   const SRNetwork parent(parent_spec());
   const Dataset data = Dataset::open(test::tiny_data());
-  TrainingEvaluator evaluator(parent, data, short_training());
+  TrainingEvaluator evaluator(parent, data, short_training(), block_drop_order(*parent));
 
-  // A narrower, shallower candidate: faded, cut and trained.
+  // A narrower, shallower candidate: faded (its dropped block whole), cut and trained.
   SearchSpaceOptions space_options;
   space_options.min_blocks = 1;
-  const SearchSpace space(parent->spec(), space_options);
+  const SearchSpace space(parent->spec(), space_options, evaluator.block_drop_order());
   std::mt19937_64 rng(7);
   ArchSpec child = space.mutate(parent->spec(), 1.0, rng);
-  ASSERT_NE(SearchSpace::key(child), SearchSpace::key(parent->spec()));
+  for (int tries = 0; child.blocks != 1 && tries < 50; ++tries) child = space.mutate(parent->spec(), 1.0, rng);
+  ASSERT_EQ(child.blocks, 1);
+  EXPECT_EQ(evaluator.parent_blocks(child), space.parent_blocks(child));
   const CandidateScore c = evaluator.evaluate(child);
   EXPECT_TRUE(std::isfinite(c.val_psnr)) << c.val_psnr;
   EXPECT_GT(c.val_psnr, 5);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "models/block_importance.h"
 #include "models/inherit.h"
 #include "tests/models/model_cases.h"
 
@@ -178,4 +179,64 @@ TEST(Inherit, DroppingBlocksKeepsTheFirstOnes) {
   EXPECT_TRUE(torch::equal(child.network->named_parameters()["backbone.blocks.3.conv2.weight"],
                            parent->named_parameters()["backbone.blocks.3.conv2.weight"]));
   EXPECT_EQ(child.network->forward(torch::rand({1, 3, 4, 4})).size(2), 12);
+}
+
+// A block whose branch writes nothing into the stream is the least important, and a child that
+// drops it (inheriting parent blocks 0 and 2) computes what the parent computes.
+TEST(Inherit, DroppingTheLeastImportantBlockKeepsTheOutput) {
+  torch::manual_seed(11);
+  for (const std::string backbone : {"pan", "edsr"}) {
+    SCOPED_TRACE(backbone);
+    ArchSpec spec = default_spec(backbone, 2);
+    spec.blocks = 3;
+    spec.widths = GroupWidths();
+    spec = resolve_spec(spec);
+    SRNetwork parent(spec);
+    randomize(*parent);
+    {
+      torch::NoGradGuard no_grad;
+      const std::string out_conv = backbone == "pan" ? "backbone.blocks.1.conv3." : "backbone.blocks.1.conv2.";
+      const auto params = parent->named_parameters();
+      params[out_conv + "weight"].zero_();
+      if (params.contains(out_conv + "bias")) params[out_conv + "bias"].zero_();
+    }
+    const auto importance = block_importance(*parent);
+    ASSERT_EQ(importance.size(), 3u);
+    EXPECT_EQ(importance[1], 0.0);
+    EXPECT_GT(importance[0], 0.0);
+    const auto order = block_drop_order(*parent);
+    EXPECT_EQ(order.front(), 1);
+    const auto kept = kept_blocks(order, 2);
+    EXPECT_EQ(kept, (std::vector<int>{0, 2}));
+
+    ArchSpec child_spec = spec;
+    child_spec.blocks = 2;
+    child_spec.widths = GroupWidths();
+    child_spec = resolve_spec(child_spec);
+    auto child = inherit(*parent, child_spec, {}, kept);
+    EXPECT_TRUE(child.fresh.empty());
+    const auto params = child.network->named_parameters();
+    const auto parent_params = parent->named_parameters();
+    for (const auto& p : params) {
+      std::string in_parent = p.key();
+      const std::string prefix = "backbone.blocks.1.";
+      if (in_parent.rfind(prefix, 0) == 0) in_parent = "backbone.blocks.2." + in_parent.substr(prefix.size());
+      EXPECT_TRUE(torch::equal(p.value(), parent_params[in_parent])) << p.key() << " <- " << in_parent;
+    }
+    torch::NoGradGuard no_grad;
+    const auto color = torch::rand({1, 3, 6, 5});
+    EXPECT_TRUE(torch::allclose(child.network->forward(color), parent->forward(color), 1e-5, 1e-6));
+  }
+}
+
+TEST(Inherit, BlockChoicesMustBeAscendingParentBlocks) {
+  SRNetwork parent(default_spec("edsr", 2));
+  ArchSpec child_spec = parent->spec();
+  child_spec.blocks = 2;
+  child_spec.widths = GroupWidths();
+  child_spec = resolve_spec(child_spec);
+  EXPECT_THROW(inherit(*parent, child_spec, {}, {3, 1}), Error);
+  EXPECT_THROW(inherit(*parent, child_spec, {}, {0, 1, 2}), Error);
+  EXPECT_THROW(inherit(*parent, child_spec, {}, {0, parent->spec().blocks}), Error);
+  EXPECT_NO_THROW(inherit(*parent, child_spec, {}, {1, 5}));
 }

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/runtime.h"
+#include "models/backbone_registry.h"
 #include "models/sr_network.h"
 #include "search/search_loop.h"
 #include "tests/support/cli_runner.h"
@@ -102,6 +103,46 @@ TEST(SearchSpace, RejectsWiderThanTheParent) {
   ArchSpec wide = space.parent();
   wide.widths.set("features", 48);
   EXPECT_FALSE(space.contains(wide));
+}
+
+// Parent blocks 1 and 3 matter least: shallower candidates keep the others, and each block gene
+// stays with the parent block it belongs to through mutation, crossover and sampling.
+TEST(SearchSpace, ShallowerCandidatesDropBlocksInTheGivenOrder) {
+  const std::vector<int> order = {1, 3, 0, 2};
+  const SearchSpace space(enhanced_pan(4), {}, order);
+  const SearchSpace trailing(enhanced_pan(4), {});
+  ArchSpec three = space.parent();
+  three.blocks = 3;
+  three.widths = GroupWidths();
+  three = resolve_spec(three);
+  EXPECT_EQ(space.parent_blocks(three), (std::vector<int>{0, 2, 3}));
+  EXPECT_EQ(trailing.parent_blocks(three), (std::vector<int>{0, 1, 2}));
+  three.blocks = 2;
+  three.widths = GroupWidths();
+  EXPECT_EQ(space.parent_blocks(resolve_spec(three)), (std::vector<int>{0, 2}));
+
+  // Crossing a 4-block spec whose parent block 2 is narrowed with a 3-block one: a 3-block child
+  // carries the narrow gene on its block 1 (parent block 2), never on its block 2 (parent block 3).
+  ArchSpec marked = space.parent();
+  marked.widths.set(block_group(2, "a"), 8);
+  three.blocks = 3;
+  three.widths = GroupWidths();
+  three = resolve_spec(three);
+  ASSERT_TRUE(space.contains(marked));
+  ASSERT_TRUE(space.contains(three));
+  auto rng = make_rng("block-genes");
+  int carried = 0;
+  for (int i = 0; i < 100; ++i) {
+    const ArchSpec child = space.crossover(marked, three, rng);
+    ASSERT_TRUE(space.contains(child)) << spec_to_yaml(child);
+    const int on_parent_block_2 = child.blocks == 3 ? 1 : 2;
+    for (int b = 0; b < child.blocks; ++b) {
+      const int width = child.widths.at(block_group(b, "a"));
+      if (b == on_parent_block_2) carried += width == 8;
+      else EXPECT_EQ(width, 20) << "child block " << b << " of " << child.blocks;
+    }
+  }
+  EXPECT_GT(carried, 0);
 }
 
 TEST(SearchLoop, PicksTheSmallestCandidateWithinTolerance) {
