@@ -141,7 +141,9 @@ PatchSampler::PatchSampler(Dataset data, PatchSamplerOptions options)
 
 PatchSampler::~PatchSampler() = default;
 
-Batch PatchSampler::build(int64_t k) const {
+Batch PatchSampler::build(int64_t k) const { return make(k, /*parallel=*/true); }
+
+Batch PatchSampler::make(int64_t k, bool parallel) const {
   const auto& o = options_;
   const Resolution lr = data_.resolutions()[lr_];
   // Draw every item's choices first from one stream: the batch depends only on (seed, k).
@@ -164,14 +166,19 @@ Batch PatchSampler::build(int64_t k) const {
     c.aug = o.augment ? static_cast<int>(rng() % 8) : 0;
   }
   std::vector<Item> items(o.batch_size);
-  tbb::parallel_for(0, o.batch_size, [&](int i) {
+  const auto make_one = [&](int i) {
     const Choice& c = choices[i];
     const auto l = data_.frame(c.frame, lr_), h = data_.frame(c.frame, hr_);
     const Augmentation aug = Augmentation::from_index(c.aug);
     const SceneInfo& scene = data_.scene_of(c.frame);  // depth is encoded with its scene's planes
     items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
                          scene.near_plane, scene.far_plane, o.augment ? &aug : nullptr);
-  });
+  };
+  if (parallel) {
+    tbb::parallel_for(0, o.batch_size, make_one);
+  } else {
+    for (int i = 0; i < o.batch_size; ++i) make_one(i);
+  }
   std::vector<int> frames;
   for (const auto& c : choices) frames.push_back(c.frame);
   return stack(items, o.channels, o.depth_encoding, frames, o.scale);
@@ -180,6 +187,10 @@ Batch PatchSampler::build(int64_t k) const {
 Batch PatchSampler::next() { return batch(next_); }
 
 Batch PatchSampler::batch(int64_t k) {
+  if (options_.prefetch == 0) {
+    next_ = k + 1;
+    return make(k, /*parallel=*/false);
+  }
   auto& slots = prefetch_->slots;
   // A jump (e.g. a resumed run) drops what was prefetched for other batch numbers.
   while (!slots.empty() && slots.front()->index != k) {

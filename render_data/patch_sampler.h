@@ -19,7 +19,8 @@
 // augment, each item gets one of the 8 flips/rotations, applied to every tensor; normals and
 // motion vectors are rotated/flipped as vectors (augment.h). Batch k depends only on the seed
 // and k (not on threads or timing), so a resumed training run sees the same data; batches are
-// built in the background (TBB), `prefetch` ahead of the last one asked for.
+// built in the background (TBB), `prefetch` ahead of the last one asked for (or, with prefetch
+// 0, on the calling thread when asked for).
 
 #include <cstdint>
 #include <memory>
@@ -39,7 +40,9 @@ struct PatchSamplerOptions {
   DepthEncoding depth_encoding = DepthEncoding::Log;  // of the depth channel (the reader's, e.g. the model's)
   bool augment = true;
   uint64_t seed = 0;
-  int prefetch = 2;  // batches built ahead
+  // Batches built ahead on TBB threads; 0: each batch is built when asked for, on the calling
+  // thread alone (no other thread runs while the caller's compute threads may own every core).
+  int prefetch = 2;
   int lr_width = 0;  // LR resolution width; 0: the smallest with a scale-x partner
 };
 
@@ -62,6 +65,7 @@ class PatchSampler {
 
  private:
   struct Prefetch;
+  Batch make(int64_t k, bool parallel) const;  // batch k, its items built in parallel or one by one
   Dataset data_;
   PatchSamplerOptions options_;
   size_t lr_, hr_;

@@ -36,6 +36,13 @@ config::Schema<TrainSchedule> schedule_schema() {
   s.field("layout", &TrainSchedule::layout,
           "activation memory layout: auto measures both on the first batch and keeps the faster")
       .one_of({"auto", "nchw", "nhwc"});
+  s.field("prefetch", &TrainSchedule::prefetch,
+          "batches built ahead on other threads; 0 builds each on the training thread between steps "
+          "(no thread competes with the compute threads)")
+      .range(0, 64);
+  // Left out of the written config at its default, so stage hashes of earlier runs hold (the
+  // batches are the same either way).
+  s.omit_when("prefetch", [](const TrainSchedule& t) { return t.prefetch == 2; });
   s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
     if (t.lr_min > t.lr_max) at.child("lr_min").fail(node["lr_min"] ? node["lr_min"] : node, "must not exceed lr_max");
   });
@@ -327,6 +334,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.channels = channels_;
   sampling.depth_encoding = network_->depth_encoding();
   sampling.augment = schedule_.augment;
+  sampling.prefetch = schedule_.prefetch;
   PatchSampler sampler(data_, sampling);
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).
   if (layout_ == MemoryLayout::Auto) layout_ = choose_layout(sampler.build(step));

@@ -43,6 +43,7 @@ struct TrainSchedule {
   int checkpoint_every = 100;   // steps
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
   std::string layout = "auto";  // activation memory layout: auto (measured) | nchw | nhwc
+  int prefetch = 2;             // batches built ahead on other threads (0: between steps)
 };
 config::Schema<TrainSchedule> schedule_schema();
 

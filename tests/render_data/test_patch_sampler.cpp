@@ -103,6 +103,16 @@ TEST(PatchSampler, DeterministicUnderTheSeedAndIndexable) {
   EXPECT_TRUE(torch::equal(c.batch(3).lr_color, first[3].lr_color));
   EXPECT_TRUE(torch::equal(c.batch(1).hr_color, first[1].hr_color));
   EXPECT_TRUE(torch::equal(c.build(4).lr_info, first[4].lr_info));
+  // Without prefetching (batches built on the calling thread) the batches are the same.
+  o.prefetch = 0;
+  PatchSampler serial(data, o);
+  for (int k = 0; k < 5; ++k) {
+    const Batch x = serial.next();
+    EXPECT_TRUE(torch::equal(x.lr_color, first[k].lr_color));
+    EXPECT_TRUE(torch::equal(x.hr_info, first[k].hr_info));
+  }
+  EXPECT_TRUE(torch::equal(serial.batch(2).hr_color, first[2].hr_color));
+  o.prefetch = 2;
   o.seed = 12;
   PatchSampler d(data, o);
   EXPECT_FALSE(torch::equal(d.next().lr_color, first[0].lr_color));
