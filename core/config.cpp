@@ -1,6 +1,10 @@
 #include "core/config.h"
 
+#include <spdlog/spdlog.h>
+
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 
 namespace cgsr::config {
@@ -101,6 +105,43 @@ std::string describe(const YAML::Node& node) {
   if (node.IsMap()) return "a map";
   return "'" + node.Scalar() + "'";
 }
+
+YAML::Node lift_moved_blocks(const YAML::Node& map, const std::vector<std::string>& moved, const Cursor& at) {
+  if (!map || !map.IsMap()) return map;
+  const auto is_moved = [&](const YAML::Node& key) {
+    return key.IsScalar() && std::find(moved.begin(), moved.end(), key.Scalar()) != moved.end();
+  };
+  bool any = false;
+  for (const auto& kv : map) any = any || is_moved(kv.first);
+  if (!any) return map;
+
+  YAML::Node out(YAML::NodeType::Map);
+  for (const auto& kv : map) {
+    if (!is_moved(kv.first)) {
+      out.force_insert(kv.first, kv.second);
+      continue;
+    }
+    const Cursor old = at.child(kv.first.Scalar());
+    if (!kv.second.IsMap()) old.fail(kv.second, "expected a map of keys, got " + describe(kv.second));
+    const std::string where = at.doc ? at.doc->locate(kv.first) : old.path;
+    const std::string here = at.path.empty() ? "the top level" : "'" + at.path + "'";
+    std::string example = "<key>";
+    for (const auto& inner : kv.second)
+      if (inner.first.IsScalar()) {
+        example = inner.first.Scalar();
+        break;
+      }
+    warn_deprecated(where, "'" + old.path + "' is deprecated: write its keys directly at " + here + " ('" +
+                               at.child(example).path + "' instead of '" + old.child(example).path + "')");
+    for (const auto& inner : kv.second) {
+      if (inner.first.IsScalar() && map[inner.first.Scalar()])
+        old.child(inner.first.Scalar())
+            .fail(inner.first, "is also given as '" + at.child(inner.first.Scalar()).path + "'; keep one");
+      out.force_insert(inner.first, inner.second);
+    }
+  }
+  return out;
+}
 }  // namespace detail
 
 std::string block_type(const Block& block) {
@@ -109,6 +150,16 @@ std::string block_type(const Block& block) {
   const YAML::Node type = block.node["type"];
   if (!type) at.fail(block.node, "missing required key 'type'");
   return Codec<std::string>::decode(type, at.child("type"));
+}
+
+void warn_deprecated(const std::string& where, const std::string& what) {
+  static std::mutex mutex;
+  static std::set<std::string> warned;
+  const std::lock_guard lock(mutex);
+  const std::string message = where + ": " + what;
+  if (warned.count(message)) return;
+  if (warned.size() < 1000) warned.insert(message);  // bounded: a long-lived process parses many configs
+  spdlog::warn("{}", message);
 }
 
 std::string to_yaml(const YAML::Node& node) {

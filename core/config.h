@@ -86,6 +86,9 @@ struct Codec;
 
 namespace detail {
 std::string describe(const YAML::Node& node);  // "'abc'", "a list", "a map", "null"
+// `map` with the keys of each block named in `moved` lifted to its level (Schema::moved_block),
+// warning once per block where it was written.
+YAML::Node lift_moved_blocks(const YAML::Node& map, const std::vector<std::string>& moved, const Cursor& at);
 template <class V>
 V scalar_as(const YAML::Node& node, const Cursor& at, const char* type_name) {
   if (!node.IsScalar()) at.fail(node, std::string("expected ") + type_name + ", got " + describe(node));
@@ -288,6 +291,40 @@ class Schema {
     fields_.push_back(std::move(f));
   }
 
+  // The keys of `sub` read and written at this level, stored in `member`: a block of options
+  // that would otherwise repeat its owner's name (`cgsr search`'s search options).
+  template <class S>
+  void inline_section(S T::*member, const Schema<S>& sub) {
+    for (const auto& inner : sub.fields_) {
+      Field f;
+      f.key = inner.key;
+      f.doc = inner.doc;
+      f.required = inner.required;
+      f.parse = [member, p = inner.parse](const YAML::Node& node, T& obj, const Cursor& at) { p(node, obj.*member, at); };
+      f.emit = [member, e = inner.emit](const T& obj) { return e(obj.*member); };
+      if (inner.member) f.member = [member, m = inner.member](const T& obj) { return m(obj.*member); };
+      if (inner.omit) f.omit = [member, o = inner.omit](const T& obj) { return o(obj.*member); };
+      if (inner.validate)
+        f.validate = [member, v = inner.validate](const T& obj, const YAML::Node& node, const Cursor& at,
+                                                  const void* field) { v(obj.*member, node, at, field); };
+      fields_.push_back(std::move(f));
+    }
+    for (const auto& check : sub.cross_checks_)
+      cross_checks_.push_back(
+          [member, check](const T& obj, const Cursor& at, const YAML::Node& node) { check(obj.*member, at, node); });
+  }
+
+  // `old_key: {...}` of older configs, whose keys now sit at this level (e.g. `search: {strategy:
+  // ..}` inside a `cgsr search` config): still read, with a deprecation warning naming the file
+  // and the old and new key; a key given both ways is an error.
+  void moved_block(std::string old_key) { moved_blocks_.push_back(std::move(old_key)); }
+
+  // Rewrites an older shape of the block into the current one before parsing (after moved
+  // blocks are lifted); it warns with warn_deprecated.
+  void upgrade(std::function<YAML::Node(const YAML::Node&, const Cursor&)> rewrite) {
+    upgrades_.push_back(std::move(rewrite));
+  }
+
   // A raw block kept for later parsing by a factory ({type: Name, ...}).
   void block(std::string key, Block T::*member, std::string doc) {
     Field f;
@@ -315,8 +352,10 @@ class Schema {
 
   // Parses `node` (a map, or null for "all defaults") into `out`, whose fields hold the defaults.
   // Keys in `reserved` belong to the caller (e.g. `type` of a typed block) and are skipped.
-  void parse(const YAML::Node& node, T& out, const Cursor& at, const std::vector<std::string>& reserved = {}) const {
-    if (node && !node.IsNull() && !node.IsMap()) at.fail(node, "expected a map of keys, got " + detail::describe(node));
+  void parse(const YAML::Node& given, T& out, const Cursor& at, const std::vector<std::string>& reserved = {}) const {
+    if (given && !given.IsNull() && !given.IsMap()) at.fail(given, "expected a map of keys, got " + detail::describe(given));
+    YAML::Node node = moved_blocks_.empty() ? given : detail::lift_moved_blocks(given, moved_blocks_, at);
+    for (const auto& rewrite : upgrades_) node = rewrite(node, at);
     std::set<std::string> seen;
     if (node && node.IsMap()) {
       for (const auto& kv : node) {
@@ -377,8 +416,12 @@ class Schema {
       if (f.key == key) return &f;
     return nullptr;
   }
+  template <class>
+  friend class Schema;  // inline_section reads another schema's fields
   std::vector<Field> fields_;
   std::vector<std::function<void(const T&, const Cursor&, const YAML::Node&)>> cross_checks_;
+  std::vector<std::string> moved_blocks_;
+  std::vector<std::function<YAML::Node(const YAML::Node&, const Cursor&)>> upgrades_;
 };
 
 // Parses the whole document with `schema`, starting from the defaults in T{}.
@@ -399,6 +442,10 @@ T parse_block_options(const Block& block, const Schema<T>& schema) {
 
 // The `type` of a {type: Name, ...} block; an error naming the block when it is missing.
 std::string block_type(const Block& block);
+
+// Logs "<where>: <what>" as a warning once per process, however often the config is parsed
+// (a deprecated key that still works).
+void warn_deprecated(const std::string& where, const std::string& what);
 
 // YAML text of a node, for config.yaml and --print-config.
 std::string to_yaml(const YAML::Node& node);

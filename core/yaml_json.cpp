@@ -1,6 +1,17 @@
 #include "core/yaml_json.h"
 
 namespace cgsr {
+namespace {
+// JSON keys are strings. A key that is a list, a map or null is valid YAML (`? [a, b]: 1`); no
+// schema accepts one, but raw blocks reach here before their schema rejects them with a file
+// position, so such a key is written as its YAML flow text rather than failing here.
+std::string key_text(const YAML::Node& key) {
+  if (key.IsScalar()) return key.Scalar();
+  YAML::Emitter out;
+  out << YAML::Flow << key;
+  return out.c_str();
+}
+}  // namespace
 
 nlohmann::ordered_json yaml_to_json(const YAML::Node& node) {
   switch (node.Type()) {
@@ -11,7 +22,7 @@ nlohmann::ordered_json yaml_to_json(const YAML::Node& node) {
     }
     case YAML::NodeType::Map: {
       auto j = nlohmann::ordered_json::object();
-      for (const auto& kv : node) j[kv.first.as<std::string>()] = yaml_to_json(kv.second);
+      for (const auto& kv : node) j[key_text(kv.first)] = yaml_to_json(kv.second);
       return j;
     }
     case YAML::NodeType::Scalar: {

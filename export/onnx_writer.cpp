@@ -19,12 +19,9 @@
 
 namespace cgsr {
 
-const char* cubic_resize_name(CubicResize mode) { return mode == CubicResize::Conv ? "conv" : "native"; }
-
-CubicResize cubic_resize_from_name(const std::string& name) {
-  if (name == "conv") return CubicResize::Conv;
-  if (name == "native") return CubicResize::Native;
-  throw Error("cubic_resize", "unknown mode '" + name + "' (valid: conv, native)" + did_you_mean(name, {"conv", "native"}));
+const std::vector<std::string>& EnumNames<CubicResize>::names() {
+  static const std::vector<std::string> names = {"conv", "native"};
+  return names;
 }
 
 namespace {

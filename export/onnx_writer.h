@@ -28,13 +28,17 @@
 #include <utility>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "models/graph.h"
 
 namespace cgsr {
 
 enum class CubicResize { Conv, Native };
-const char* cubic_resize_name(CubicResize mode);    // "conv", "native"
-CubicResize cubic_resize_from_name(const std::string& name);  // cgsr::Error listing the valid names
+template <>
+struct EnumNames<CubicResize> {
+  static constexpr const char* kind = "cubic resize";
+  static const std::vector<std::string>& names();  // conv, native
+};
 
 struct OnnxOptions {
   int64_t width = 0, height = 0;  // LR input size written into the file; ignored with dynamic_size

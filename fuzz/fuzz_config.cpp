@@ -19,6 +19,7 @@
 #include "cli/commands/train.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/yaml_json.h"
 #include "train/evaluation.h"
 
 namespace {
@@ -28,7 +29,9 @@ template <class T>
 void parse_with(const config::Document& doc, const config::Schema<T>& schema) {
   try {
     const T options = config::parse_document(doc, schema);
-    (void)config::to_yaml(schema.emit(options));  // what config.yaml would hold
+    const YAML::Node resolved = schema.emit(options);
+    (void)config::to_yaml(resolved);  // what config.yaml would hold
+    (void)yaml_to_json(resolved);     // what results.json and model files record
   } catch (const Error&) {
   }
 }
@@ -65,10 +68,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const PipelineOptions pipeline = config::parse_document(doc, pipeline_schema());
     parse_block_with(pipeline.train, train_schema());
-    parse_block_with(pipeline.enhance, train_schema());
+    parse_block_with(pipeline.enhance, enhance_stage_schema());
     parse_block_with(pipeline.search, search_command_schema());
     parse_block_with(pipeline.prune, prune_command_schema());
     parse_block_with(pipeline.eval, eval_schema_fields());
+    // The search stage hashes its config in its older shape.
+    if (pipeline.search.node) {
+      SearchCommandOptions search{};
+      search_command_schema().parse(pipeline.search.node, search, pipeline.search.cursor());
+      (void)config::to_yaml(search_config_cache_form(search_command_schema().emit(search)));  // the stage's hash
+    }
   } catch (const Error&) {
   }
   return 0;

@@ -3,7 +3,8 @@
 # the 64x48 files of frame 0 of configs/scenes/tiny.yaml, and a small CG-enhanced PAN model
 # file (format version 2) next to the version 1 test fixture (tests/data/model_file_v1.cgsr, which
 # this cgsr can no longer write). Config seeds are the files in configs/ (the fuzz tests read them
-# there).
+# there) plus the hand-written ones in fuzz/corpus/config/ (regressions and the configs' former
+# shapes), which this script leaves alone.
 #   fuzz/make_seeds.sh [BUILD_DIR]     (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."

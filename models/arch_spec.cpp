@@ -56,10 +56,17 @@ YAML::Node Codec<GroupWidths>::encode(const GroupWidths& widths) {
 
 // ---- spec --------------------------------------------------------------------------------------
 
-const std::vector<std::string>& rit_sources() {
-  static const std::vector<std::string> sources = {"lr", "hr_pooled", "hr_unshuffle", "hr_fuse",
-                                                   "hr_unshuffle+hr_fuse"};
-  return sources;
+const std::vector<std::string>& EnumNames<RitSource>::names() {
+  static const std::vector<std::string> names = {"lr", "hr_pooled", "hr_unshuffle", "hr_fuse", "hr_unshuffle+hr_fuse"};
+  return names;
+}
+const std::vector<std::string>& EnumNames<RitFusion>::names() {
+  static const std::vector<std::string> names = {"concat", "add"};
+  return names;
+}
+const std::vector<std::string>& EnumNames<Colors>::names() {
+  static const std::vector<std::string> names = {"rgb", "y"};
+  return names;
 }
 
 int ArchSpec::group_width(const std::string& group) const {
@@ -112,9 +119,7 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"scale", "scale must be 2, 3 or 4, got " + std::to_string(spec.scale)});
     return problems;
   }
-  if (spec.colors != "rgb" && spec.colors != "y")
-    problems.push_back({"colors", "'" + spec.colors + "' is not one of: rgb, y"});
-  else if (spec.colors == "y" && !info.supports_y)
+  if (spec.colors == Colors::Y && !info.supports_y)
     problems.push_back({"colors", spec.backbone + " works on RGB only (colors: y is for srcnn)"});
   if (spec.blocks >= 0 && (spec.blocks < info.min_blocks || spec.blocks > info.max_blocks))
     problems.push_back({"blocks", info.max_blocks == 0
@@ -152,16 +157,12 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   }
   if (spec.rit.width < 1)
     problems.push_back({"rit.width", "must be at least 1, got " + std::to_string(spec.rit.width)});
-  if (std::find(rit_sources().begin(), rit_sources().end(), spec.rit.source) == rit_sources().end())
-    problems.push_back({"rit.source", "'" + spec.rit.source + "' is not one of: " + join(rit_sources(), ", ")});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", "must be at least 1, got " + std::to_string(spec.rit.hr_width)});
   if (std::find(EnumNames<DepthEncoding>::names().begin(), EnumNames<DepthEncoding>::names().end(), spec.rit.depth_encoding) ==
       EnumNames<DepthEncoding>::names().end())
     problems.push_back({"rit.depth_encoding",
                         "'" + spec.rit.depth_encoding + "' is not one of: " + join(EnumNames<DepthEncoding>::names(), ", ")});
-  if (spec.rit.fusion != "concat" && spec.rit.fusion != "add")
-    problems.push_back({"rit.fusion", "'" + spec.rit.fusion + "' is not one of: concat, add"});
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -226,10 +227,9 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("enabled", &RitSpec::enabled, "insert the rendering information transform block");
   rit.field("channels", &RitSpec::channels, "rendering channels the network reads (render_channels.h names)");
   rit.field("width", &RitSpec::width, "features the RIT convolution produces").at_least(1);
-  rit.field("source", &RitSpec::source, "where the rendering information comes from and joins the backbone")
-      .one_of(rit_sources());
+  rit.field("source", &RitSpec::source, "where the rendering information comes from and joins the backbone");
   rit.field("hr_width", &RitSpec::hr_width, "features of the HR branch (hr_fuse)").at_least(1);
-  rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone").one_of({"concat", "add"});
+  rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone");
   rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network")
       .one_of(EnumNames<DepthEncoding>::names());
   return rit;
@@ -246,7 +246,7 @@ config::Schema<ArchSpec> arch_spec_schema() {
   config::Schema<ArchSpec> s;
   s.field("backbone", &ArchSpec::backbone, "backbone name (" + join(backbone_registry().names()) + ")");
   s.field("scale", &ArchSpec::scale, "upscaling factor").range(2, 4);
-  s.field("colors", &ArchSpec::colors, "colour channels the network works on").one_of({"rgb", "y"});
+  s.field("colors", &ArchSpec::colors, "colour channels the network works on");
   s.field("blocks", &ArchSpec::blocks, "number of residual blocks (default: the backbone's)");
   s.field("widths", &ArchSpec::widths, "width of each prunable layer group (default: the backbone's)");
   s.section("rit", &ArchSpec::rit, rit_spec_schema(), "rendering information transform block");
@@ -286,13 +286,13 @@ void save_spec_file(const std::filesystem::path& path, const ArchSpec& spec) {
 
 std::string spec_summary(const ArchSpec& spec) {
   std::string s = spec.backbone + " x" + std::to_string(spec.scale);
-  if (spec.colors == "y") s += " (Y)";
+  if (spec.colors == Colors::Y) s += " (Y)";
   if (spec.rit.enabled) {
     const auto& r = spec.rit;
     std::string widths;
     if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
-    s += " + rit[" + join(r.channels, "+") + widths + ", " + r.source + ", " + r.fusion + ", " + r.depth_encoding +
+    s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + r.depth_encoding +
          " depth]";
   }
   if (spec.geometry.enabled) s += " + geometry head";

@@ -58,13 +58,38 @@ class GroupWidths {
   std::vector<std::pair<std::string, int>> entries_;
 };
 
+// Where the rendering information comes from and where it joins the backbone (rit.h); spelled
+// lr, hr_pooled, hr_unshuffle, hr_fuse, hr_unshuffle+hr_fuse in specs and model files.
+enum class RitSource { Lr, HrPooled, HrUnshuffle, HrFuse, HrUnshuffleHrFuse };
+template <>
+struct EnumNames<RitSource> {
+  static constexpr const char* kind = "rit source";
+  static const std::vector<std::string>& names();
+};
+
+// How RIT features join the backbone: concat (feat + 1x1(cat(feat, rit))) or add (feat + 1x1(rit)).
+enum class RitFusion { Concat, Add };
+template <>
+struct EnumNames<RitFusion> {
+  static constexpr const char* kind = "rit fusion";
+  static const std::vector<std::string>& names();
+};
+
+// The colour channels a network works on: rgb, or y (BT.601 luma; SRCNN only).
+enum class Colors { Rgb, Y };
+template <>
+struct EnumNames<Colors> {
+  static constexpr const char* kind = "colors";
+  static const std::vector<std::string>& names();
+};
+
 struct RitSpec {
   bool enabled = false;
   std::vector<std::string> channels = {"depth", "normal", "normal_angle", "edge"};  // render_channels.h names
   int width = 16;                 // features the RIT convolution produces (layer group "rit")
-  std::string source = "lr";      // one of rit_sources()
+  RitSource source = RitSource::Lr;
   int hr_width = 16;              // features of the HR branch (layer group "rit_hr")
-  std::string fusion = "concat";  // concat | add
+  RitFusion fusion = RitFusion::Concat;
   std::string depth_encoding = "log";  // log | linear | zbuffer
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
@@ -72,19 +97,19 @@ struct RitSpec {
   DepthEncoding depth() const { return enum_from_name<DepthEncoding>(depth_encoding); }
   // The parts the source asks for: the block at the backbone's feature map (lr, hr_pooled,
   // hr_unshuffle) and the branch at the HR features (hr_fuse).
-  bool feature_branch() const { return source != "hr_fuse"; }
-  bool hr_branch() const { return source == "hr_fuse" || source == "hr_unshuffle+hr_fuse"; }
-  bool unshuffles() const { return source == "hr_unshuffle" || source == "hr_unshuffle+hr_fuse"; }
+  bool feature_branch() const { return source != RitSource::HrFuse; }
+  bool hr_branch() const { return source == RitSource::HrFuse || source == RitSource::HrUnshuffleHrFuse; }
+  bool unshuffles() const { return source == RitSource::HrUnshuffle || source == RitSource::HrUnshuffleHrFuse; }
   // Every source except lr reads the rendering information at the output resolution.
-  bool reads_hr() const { return source != "lr"; }
+  bool reads_hr() const { return source != RitSource::Lr; }
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
            hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding;
   }
 };
 
-// The values of rit.source, in the order ablations list them.
-const std::vector<std::string>& rit_sources();
+// The names of rit.source, in the order ablations list them.
+inline const std::vector<std::string>& rit_sources() { return EnumNames<RitSource>::names(); }
 
 struct GeometrySpec {
   bool enabled = false;
@@ -95,7 +120,7 @@ struct GeometrySpec {
 struct ArchSpec {
   std::string backbone = "pan";
   int scale = 2;
-  std::string colors = "rgb";  // rgb | y
+  Colors colors = Colors::Rgb;
   int blocks = -1;             // -1 until resolved: the backbone's default
   GroupWidths widths;
   RitSpec rit;
@@ -106,7 +131,7 @@ struct ArchSpec {
   void set_group_width(const std::string& group, int width);
   // Rendering channels the network takes as input (empty without RIT).
   std::vector<RenderChannel> input_channels() const;
-  int color_channels() const { return colors == "y" ? 1 : 3; }
+  int color_channels() const { return colors == Colors::Y ? 1 : 3; }
 
   bool operator==(const ArchSpec& o) const {
     return backbone == o.backbone && scale == o.scale && colors == o.colors && blocks == o.blocks &&

@@ -20,19 +20,17 @@ Complexity complexity(const graph::Graph& graph, int64_t lr_width, int64_t lr_he
     layer.out_height = lr_height * out.factor;
     layer.out_channels = graph::layout_width(out.layout);
     layer.trainable = op.trainable;
-    if (op.kind == graph::OpKind::Conv) {
+    const auto traits = graph::op_traits(op.kind);
+    if (!traits.has_tensors) continue;
+    if (op.trainable) layer.params = graph::tensor_elements(op);
+    layer.macs = graph::macs_per_output_pixel(op) * layer.out_width * layer.out_height;
+    if (traits.mixes_channels) {
       layer.in_channels = op.weight.size(1) * op.groups;
       layer.kernel = op.kernel_size();
       layer.groups = op.groups;
-      layer.macs = op.weight.numel() * layer.out_width * layer.out_height;
-      if (op.trainable) layer.params = op.weight.numel() + (op.bias.defined() ? op.bias.numel() : 0);
-    } else if (op.kind == graph::OpKind::ChannelAffine) {
-      layer.in_channels = layer.out_channels;
-      if (op.trainable)
-        layer.params = (op.scale.defined() ? op.scale.numel() : 0) + (op.shift.defined() ? op.shift.numel() : 0);
-      if (layer.params == 0) continue;  // a constant element-wise op: nothing to count
     } else {
-      continue;
+      layer.in_channels = layer.out_channels;
+      if (layer.params == 0) continue;  // a constant element-wise op: nothing to count
     }
     c.params += layer.params;
     c.macs += layer.macs;

@@ -48,6 +48,42 @@ const char* op_kind_name(OpKind kind) {
   return "?";
 }
 
+OpTraits op_traits(OpKind kind) {
+  switch (kind) {
+    case OpKind::Conv: return {/*has_tensors=*/true, /*mixes_channels=*/true};
+    case OpKind::ChannelAffine: return {/*has_tensors=*/true, /*mixes_channels=*/false};
+    case OpKind::Relu:
+    case OpKind::LeakyRelu:
+    case OpKind::Sigmoid:
+    case OpKind::PixelShuffle:
+    case OpKind::Resize:
+    case OpKind::AvgPool:
+    case OpKind::Add:
+    case OpKind::Mul:
+    case OpKind::Concat: return {};
+  }
+  return {};
+}
+
+int64_t tensor_elements(const Op& op) {
+  int64_t n = 0;
+  for (const auto* t : {&op.weight, &op.bias, &op.scale, &op.shift})
+    if (t->defined()) n += t->numel();
+  return n;
+}
+
+int64_t macs_per_output_pixel(const Op& op) { return op.kind == OpKind::Conv ? op.weight.numel() : 0; }
+
+torch::Tensor output_channel_magnitude(const Op& op) {
+  CGSR_CHECK(op_traits(op.kind).has_tensors, "output_channel_magnitude: " + op.name + " has no tensors");
+  if (op.kind == OpKind::Conv) {
+    auto rows = op.weight.abs().sum({1, 2, 3});
+    return op.bias.defined() ? rows + op.bias.abs() : rows;
+  }
+  torch::Tensor t = op.scale.defined() ? op.scale.abs() : torch::zeros({op.shift.numel()});
+  return op.shift.defined() ? t + op.shift.abs() : t;
+}
+
 const char* resize_mode_name(ResizeMode mode) {
   switch (mode) {
     case ResizeMode::Nearest: return "nearest";

@@ -103,6 +103,29 @@ struct Op {
   int64_t kernel_size() const { return weight.defined() ? weight.size(-1) : 0; }
 };
 
+// What pruning, inheritance and complexity need to know about an op kind, in one table (the
+// ONNX and TorchScript writers and the fused graph keep their own closed switches, so the
+// compiler flags a kind they miss).
+struct OpTraits {
+  // Holds tensors: a Conv its weight and bias, a ChannelAffine its scale and shift (the
+  // network's parameters when trainable, else constants). These are the ops pruning narrows.
+  bool has_tensors = false;
+  // Every output channel reads every input channel (a Conv, through its weight's columns), so
+  // narrowing the input narrows the tensors too and ties the input's layer groups to the
+  // output's. Otherwise output channel c reads input channel c only (element-wise ops).
+  bool mixes_channels = false;
+};
+OpTraits op_traits(OpKind kind);
+
+// The op's tensor elements (weight + bias, or scale + shift): its parameters when trainable.
+int64_t tensor_elements(const Op& op);
+// Multiply-accumulates per output pixel: the weight's elements for a Conv, 0 for the rest
+// (element-wise work is not counted).
+int64_t macs_per_output_pixel(const Op& op);
+// L1 magnitude per output channel of an op with tensors: sum |weight row| + |bias| of a Conv,
+// |scale| + |shift| of a ChannelAffine.
+torch::Tensor output_channel_magnitude(const Op& op);
+
 struct Graph {
   std::vector<Value> values;
   std::vector<Op> ops;  // topological order

@@ -16,14 +16,9 @@ torch::Tensor forward_in(SRNetworkImpl& net, const torch::Tensor& lr_color, cons
 }
 }  // namespace
 
-InferenceEngine inference_engine_from_name(const std::string& name) {
-  if (name == "fused") return InferenceEngine::Fused;
-  if (name == "libtorch") return InferenceEngine::LibTorch;
-  throw Error("inference engine", "'" + name + "' is not one of: fused, libtorch");
-}
-
-const char* inference_engine_name(InferenceEngine engine) {
-  return engine == InferenceEngine::Fused ? "fused" : "libtorch";
+const std::vector<std::string>& EnumNames<InferenceEngine>::names() {
+  static const std::vector<std::string> names = {"fused", "libtorch"};
+  return names;
 }
 
 MemoryLayout inference_layout(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info,

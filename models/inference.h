@@ -23,8 +23,11 @@ enum class InferenceEngine {
   Fused,     // FusedGraph (fused_graph.h): oneDNN with element-wise ops fused into convolutions
   LibTorch,  // the modules' forward in the measured layout: the reference the tests compare with
 };
-InferenceEngine inference_engine_from_name(const std::string& name);  // fused | libtorch
-const char* inference_engine_name(InferenceEngine engine);
+template <>
+struct EnumNames<InferenceEngine> {
+  static constexpr const char* kind = "inference engine";
+  static const std::vector<std::string>& names();  // fused, libtorch
+};
 
 // [N, 3, s*h, s*w], contiguous NCHW. Puts the network in eval mode.
 torch::Tensor infer(SRNetworkImpl& net, const torch::Tensor& lr_color, const torch::Tensor& info = {},

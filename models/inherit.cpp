@@ -62,7 +62,8 @@ std::vector<std::string> inheritance_problems(const ArchSpec& parent, const Arch
     p.push_back("backbone " + child.backbone + " differs from the parent's " + parent.backbone);
   if (child.scale != parent.scale)
     p.push_back("scale x" + std::to_string(child.scale) + " differs from the parent's x" + std::to_string(parent.scale));
-  if (child.colors != parent.colors) p.push_back("colors " + child.colors + " differ from the parent's " + parent.colors);
+  if (child.colors != parent.colors)
+    p.push_back("colors " + enum_name(child.colors) + " differ from the parent's " + enum_name(parent.colors));
   if (!p.empty()) return p;
   if (child.blocks > parent.blocks)
     p.push_back("child has " + std::to_string(child.blocks) + " blocks, the parent only " +
@@ -78,9 +79,11 @@ std::vector<std::string> inheritance_problems(const ArchSpec& parent, const Arch
   }
   if (child.rit.enabled && parent.rit.enabled) {
     if (child.rit.source != parent.rit.source)
-      p.push_back("rit.source " + child.rit.source + " differs from the parent's " + parent.rit.source);
+      p.push_back("rit.source " + enum_name(child.rit.source) + " differs from the parent's " +
+                  enum_name(parent.rit.source));
     if (child.rit.fusion != parent.rit.fusion)
-      p.push_back("rit.fusion " + child.rit.fusion + " differs from the parent's " + parent.rit.fusion);
+      p.push_back("rit.fusion " + enum_name(child.rit.fusion) + " differs from the parent's " +
+                  enum_name(parent.rit.fusion));
     for (const auto& c : child.rit.channels)
       if (std::find(parent.rit.channels.begin(), parent.rit.channels.end(), c) == parent.rit.channels.end())
         p.push_back("rit channel " + c + " is not read by the parent (" + join(parent.rit.channels) + ")");
@@ -215,7 +218,7 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
     assigned.insert(dst.unsafeGetTensorImpl());
   };
   for (const auto& op : cg.ops) {
-    if (!op.trainable || (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine)) continue;
+    if (!op.trainable || !graph::op_traits(op.kind).has_tensors) continue;
     const graph::Op* pop = pg.find_op(map.op(op.name));
     if (!pop) {
       CGSR_CHECK(fresh_allowed(op.name), "inherit: the parent has no " + op.name);
@@ -223,7 +226,7 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
     }
     const auto out = axis_indices(pg.values[pop->output].layout, cg.values[op.output].layout, result.kept, map,
                                   op.name + " output");
-    if (op.kind == graph::OpKind::Conv) {
+    if (graph::op_traits(op.kind).mixes_channels) {
       CGSR_CHECK(op.groups == 1 && pop->groups == 1, "inherit: grouped convs are not supported");
       const auto in = axis_indices(pg.values[pop->inputs[0]].layout, cg.values[op.inputs[0]].layout, result.kept,
                                    map, op.name + " input");

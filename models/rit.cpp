@@ -25,9 +25,9 @@ torch::nn::Conv2d make_fusion(bool concat, int64_t feature_channels, int64_t wid
 }  // namespace
 
 RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, FusionPoint hr_features)
-    : concat_(rit.fusion == "concat"),
+    : concat_(rit.fusion == RitFusion::Concat),
       info_factor_(rit.reads_hr() ? scale : 1),
-      pool_factor_(rit.source == "hr_pooled" ? scale : 1),
+      pool_factor_(rit.source == RitSource::HrPooled ? scale : 1),
       stride_(rit.unshuffles() ? scale : 1),
       upsample_factor_(features.factor) {
   const int64_t c = total_width(rit.render_channels());

@@ -144,18 +144,8 @@ std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::G
 std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph) {
   std::map<std::string, torch::Tensor> out;
   for (const auto& op : graph.ops) {
-    if (!op.trainable) continue;
-    // Per output position: |weights| and |bias| of the conv, |scale| and |shift| of an affine.
-    torch::Tensor per_position;
-    if (op.kind == graph::OpKind::Conv) {
-      per_position = op.weight.abs().sum({1, 2, 3});
-      if (op.bias.defined()) per_position = per_position + op.bias.abs();
-    } else if (op.kind == graph::OpKind::ChannelAffine) {
-      per_position = op.scale.defined() ? op.scale.abs() : torch::zeros({op.shift.numel()});
-      if (op.shift.defined()) per_position = per_position + op.shift.abs();
-    } else {
-      continue;
-    }
+    if (!op.trainable || !graph::op_traits(op.kind).has_tensors) continue;
+    const torch::Tensor per_position = graph::output_channel_magnitude(op);
     int64_t offset = 0;
     for (const auto& s : graph.values[op.output].layout) {
       const int64_t span = s.channels * s.repeat;

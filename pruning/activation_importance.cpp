@@ -15,7 +15,7 @@ std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::v
   for (const auto& u : units) dynamic.insert(u.groups.begin(), u.groups.end());
   std::set<int> conv_inputs;
   for (const auto& op : graph.ops)
-    if (op.kind == graph::OpKind::Conv) conv_inputs.insert(op.inputs[0]);
+    if (graph::op_traits(op.kind).mixes_channels) conv_inputs.insert(op.inputs[0]);
   std::vector<size_t> out;
   for (size_t i = 0; i < graph.ops.size(); ++i) {
     const int v = graph.ops[i].output;
@@ -58,7 +58,7 @@ FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const s
     const auto out = graph::run(g, inputs, nullptr, observe);
     if (taylor) {
       const auto image = out.front().second;
-      reconstruction_error(image, batch.hr_color, "l2").backward();
+      reconstruction_error(image, batch.hr_color, ErrorNorm::L2).backward();
     }
     torch::NoGradGuard no_grad_after;
     for (const auto& [index, value] : captured) {

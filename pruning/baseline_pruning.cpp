@@ -34,7 +34,8 @@ config::Schema<BaselineOptions> baseline_schema() {
 }
 
 std::string baseline_label(const BaselineOptions& options) {
-  std::string label = options.type == "magnitude" ? "MMP" : options.type + " pruning";
+  const std::string& paper_name = importance_methods().get(options.type).baseline_name;
+  std::string label = paper_name.empty() ? options.type + " pruning" : paper_name;
   if (options.keep_rate > 0) label += " " + fixed(options.keep_rate, 2);
   return label;
 }

@@ -81,7 +81,7 @@ SelectedTensors select_op_tensors(const graph::Graph& graph, const graph::Op& op
   SelectedTensors t{op.weight, op.bias, op.scale, op.shift};
   const auto& out_layout = graph.values[op.output].layout;
   const bool out_narrows = narrows(out_layout, keep);
-  if (op.kind == graph::OpKind::Conv) {
+  if (graph::op_traits(op.kind).mixes_channels) {
     const auto& in_layout = graph.values[op.inputs[0]].layout;
     const bool in_narrows = narrows(in_layout, keep);
     if (!out_narrows && !in_narrows) return t;
@@ -92,7 +92,7 @@ SelectedTensors select_op_tensors(const graph::Graph& graph, const graph::Op& op
       if (t.bias.defined()) t.bias = take(t.bias, 0, rows);
     }
     if (in_narrows) t.weight = take(t.weight, 1, selected_positions(in_layout, keep));
-  } else if (op.kind == graph::OpKind::ChannelAffine && out_narrows) {
+  } else if (graph::op_traits(op.kind).has_tensors && out_narrows) {
     const auto positions = selected_positions(out_layout, keep);
     if (t.scale.defined()) t.scale = take(t.scale, 0, positions);
     if (t.shift.defined()) t.shift = take(t.shift, 0, positions);
@@ -105,7 +105,7 @@ graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& 
   torch::NoGradGuard no_grad;
   graph::Graph out = graph;
   for (auto& op : out.ops) {
-    if (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine) continue;
+    if (!graph::op_traits(op.kind).has_tensors) continue;
     auto t = select_op_tensors(graph, op, keep);
     op.weight = t.weight;
     op.bias = t.bias;

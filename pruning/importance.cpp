@@ -25,19 +25,22 @@ const Registry<ImportanceMethod>& importance_methods() {
     Registry<ImportanceMethod> r("importance method");
     r.add(
         "taylor",
-        [](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
-          return frame_importance(net, b, u, ActivationScore::Taylor);
-        },
+        {[](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
+           return frame_importance(net, b, u, ActivationScore::Taylor);
+         },
+         /*same_on_every_frame=*/false, /*baseline_name=*/""},
         "|activation x gradient of the reconstruction loss| per channel on the frame");
     r.add(
         "activation",
-        [](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
-          return frame_importance(net, b, u, ActivationScore::MeanAbsolute);
-        },
+        {[](SRNetworkImpl& net, const Batch& b, const std::vector<PrunableUnit>& u) {
+           return frame_importance(net, b, u, ActivationScore::MeanAbsolute);
+         },
+         /*same_on_every_frame=*/false, /*baseline_name=*/""},
         "mean |activation| per channel on the frame");
     r.add(
         "magnitude",
-        [](SRNetworkImpl& net, const Batch&, const std::vector<PrunableUnit>& u) { return magnitude_importance(net, u); },
+        {[](SRNetworkImpl& net, const Batch&, const std::vector<PrunableUnit>& u) { return magnitude_importance(net, u); },
+         /*same_on_every_frame=*/true, /*baseline_name=*/"MMP"},
         "L1 norm of the weights producing the channel (the same on every frame)");
     return r;
   }();

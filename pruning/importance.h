@@ -9,9 +9,10 @@
 //               the same for every frame
 //
 //   const auto& method = importance_methods().get("taylor");
-//   FrameImportance scores = method(net, batch, units);
+//   FrameImportance scores = method.score(net, batch, units);
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/registry.h"
@@ -22,8 +23,12 @@
 
 namespace cgsr {
 
-// For every group of `units`: importance [width] (CPU float, larger = keep) under the batch.
-using ImportanceMethod = std::function<FrameImportance(SRNetworkImpl&, const Batch&, const std::vector<PrunableUnit>&)>;
+struct ImportanceMethod {
+  // For every group of `units`: importance [width] (CPU float, larger = keep) under the batch.
+  std::function<FrameImportance(SRNetworkImpl&, const Batch&, const std::vector<PrunableUnit>&)> score;
+  bool same_on_every_frame = false;  // one frame ranks the channels
+  std::string baseline_name;         // the paper's name of pruning by this method ("" = "<name> pruning")
+};
 
 const Registry<ImportanceMethod>& importance_methods();
 

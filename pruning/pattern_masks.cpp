@@ -73,16 +73,10 @@ std::map<std::string, torch::Tensor> PatternMasks::attached_l1() const {
   for (const auto& u : pool_.units)
     for (size_t index : u.ops) {
       const auto& op = graph_.ops[index];
-      if (op.kind == graph::OpKind::Conv) {
-        auto rows = op.weight.abs().sum({1, 2, 3});
-        if (op.bias.defined()) rows = rows + op.bias.abs();
-        accumulate(rows, graph_.values[op.output].layout);
-        accumulate(op.weight.abs().sum({0, 2, 3}), graph_.values[op.inputs[0]].layout);
-      } else if (op.kind == graph::OpKind::ChannelAffine) {
-        torch::Tensor t = op.scale.defined() ? op.scale.abs() : torch::zeros({op.shift.numel()});
-        if (op.shift.defined()) t = t + op.shift.abs();
-        accumulate(t, graph_.values[op.output].layout);
-      }
+      const auto traits = graph::op_traits(op.kind);
+      if (!traits.has_tensors) continue;
+      accumulate(graph::output_channel_magnitude(op), graph_.values[op.output].layout);
+      if (traits.mixes_channels) accumulate(op.weight.abs().sum({0, 2, 3}), graph_.values[op.inputs[0]].layout);
     }
   return out;
 }

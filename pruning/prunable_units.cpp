@@ -77,7 +77,7 @@ std::vector<PrunableUnit> find_units(const graph::Graph& graph) {
   Components components;
   for (const auto& g : order) components.find(g);
   for (const auto& op : graph.ops) {
-    if (op.kind != graph::OpKind::Conv) continue;
+    if (!graph::op_traits(op.kind).mixes_channels) continue;  // element-wise ops keep channel c as channel c
     std::vector<std::string> touched;
     for (const auto& g : prunable_groups(graph.values[op.inputs[0]].layout))
       if (widths.count(g)) touched.push_back(g);
@@ -102,9 +102,10 @@ std::vector<PrunableUnit> find_units(const graph::Graph& graph) {
 
   for (size_t index = 0; index < graph.ops.size(); ++index) {
     const auto& op = graph.ops[index];
-    if (op.kind != graph::OpKind::Conv && op.kind != graph::OpKind::ChannelAffine) continue;
+    const auto traits = graph::op_traits(op.kind);
+    if (!traits.has_tensors) continue;
     auto groups = prunable_groups(graph.values[op.output].layout);
-    if (op.kind == graph::OpKind::Conv)
+    if (traits.mixes_channels)
       for (const auto& g : prunable_groups(graph.values[op.inputs[0]].layout)) groups.insert(g);
     int owners = 0;
     for (auto& u : units)

@@ -81,11 +81,11 @@ nlohmann::ordered_json against(const EvalResult& r, const EvalResult& base) {
 std::vector<FrameImportance> importance_on(SRNetworkImpl& net, const Dataset& data, const std::vector<int>& frames,
                                            const std::string& method) {
   const auto units = find_units(net.describe(false));
-  const auto& score = importance_methods().get(method);
+  const ImportanceMethod& importance_method = importance_methods().get(method);
   std::vector<FrameImportance> out;
   Progress progress("importance (" + method + ")", static_cast<int64_t>(frames.size()));
   for (int f : frames) {
-    out.push_back(score(net, frame_batch(data, f, net.spec().scale, net.input_channels(), net.depth_encoding()), units));
+    out.push_back(importance_method.score(net, frame_batch(data, f, net.spec().scale, net.input_channels(), net.depth_encoding()), units));
     progress.advance();
   }
   progress.finish();
@@ -163,7 +163,8 @@ PrunedBaseline prune_baseline(const BaselineContext& c, const BaselineOptions& o
   const std::string stem = "baseline" + std::to_string(index) + "_" + options.type;
   b.file = c.out / (stem + ".cgsr");
   // A frame-independent method needs one frame.
-  const auto ranked = options.type == "magnitude" ? std::vector<int>{c.frames.front()} : c.frames;
+  const auto ranked = importance_methods().get(options.type).same_on_every_frame ? std::vector<int>{c.frames.front()}
+                                                                                 : c.frames;
   const auto order = importance_order(find_units(net.describe(false)), importance_on(net, c.data, ranked, options.type));
   Inheritance pruned = prune_to_rate(net, order, b.keep_rate);
   spdlog::info("fine-tuning the {} baseline ({}, keep rate {:.3f}): {} steps", options.type,
@@ -180,20 +181,79 @@ PrunedBaseline prune_baseline(const BaselineContext& c, const BaselineOptions& o
   training[stem] = to_json(outcome);
   return b;
 }
+
+// Step 2: every pattern of the pool fine-tuned by the sandwich rule (resumable).
+TrainOutcome finetune_patterns(SRNetwork& net, DynamicPruning& dynamic, const Dataset& data, const PruneOptions& options,
+                               const TrainSchedule& schedule, const std::filesystem::path& out, bool resume) {
+  spdlog::info("fine-tuning {} nested patterns: {} steps ({} epochs)", dynamic.pool().size(), schedule.steps,
+               options.finetune.epochs);
+  Trainer finetune(net, data, schedule, options.finetune.loss, {}, dynamic.hooks(options.finetune));
+  return finetune.run(out / "finetune_hybrid.pt", resume);
+}
+
+// Step 6: the input network, the baselines, the static network and the hybrid model (read back
+// from its file) evaluated through the same code path as `cgsr eval`; the hybrid's per-pattern
+// test usage goes to `test_usage`.
+std::vector<EvalResult> evaluate_roles(const PruneRoles& roles, const StaticPruning& pruned, size_t patterns,
+                                       const Dataset& data, const EvalOptions& eval, std::vector<int>& test_usage) {
+  std::vector<EvalResult> evaluations;
+  {
+    NetworkUpscaler dense(roles.input.name, load_model(roles.input.file).network);
+    evaluations.push_back(evaluate(dense, data, eval));
+  }
+  for (const auto& b : roles.baselines) {
+    NetworkUpscaler baseline(b.name, load_model(b.file).network);
+    evaluations.push_back(evaluate(baseline, data, eval));
+  }
+  {
+    NetworkUpscaler static_only(roles.static_network.name, pruned.network);
+    evaluations.push_back(evaluate(static_only, data, eval));
+  }
+  HybridUpscaler from_file(roles.hybrid.name, load_hybrid_model(roles.hybrid.file));
+  evaluations.push_back(evaluate(from_file, data, eval));
+  // Per pattern, the evaluated frames that chose it (the upscaler also ran frames before them,
+  // for the temporal error).
+  test_usage.assign(patterns, 0);
+  if (const auto choices = pattern_choices(evaluations.back()))
+    for (const auto& [k, n] : choices->usage) test_usage.at(k) = n;
+  return evaluations;
+}
+
+// The evaluations and each one's difference to the first (the input network), also logged.
+void add_evaluations(nlohmann::ordered_json& results, const std::vector<EvalResult>& evaluations) {
+  results["evaluations"] = nlohmann::ordered_json::array();
+  results["comparison"] = nlohmann::ordered_json::array();
+  for (const auto& r : evaluations) {
+    results["evaluations"].push_back(to_json(r));
+    results["comparison"].push_back(against(r, evaluations.front()));
+    spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f}, params {}, MACs {}{}", r.name, r.psnr, r.ssim,
+                 r.cost ? format_count(static_cast<double>(r.cost->params)) : "-",
+                 r.cost ? format_count(static_cast<double>(r.cost->macs)) : "-",
+                 r.latency ? ", " + std::to_string(r.latency->median_ms) + " ms" : "");
+  }
+}
+
+// The input model, checked for what pruning needs, and its display name.
+Model load_prunable(const std::filesystem::path& model_path, const Dataset& data, const PruneOptions& options,
+                    std::string& name) {
+  const std::string where = model_path.string();
+  if (!is_model_file(model_path)) throw Error(where, "not a trained model file (cgsr prune needs trained weights)");
+  Model input = load_model(model_path);
+  name = options.name.empty() ? input.provenance.extra.value("name", model_path.stem().string()) : options.name;
+  if (find_units(input.network->describe(false)).empty())
+    throw Error(where, "the network has no layer groups that can be pruned per frame");
+  if (data.frames(Split::Train).empty()) throw Error(data.info().root.string(), "the data set has no training frames");
+  return input;
+}
 }  // namespace
 
 nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Dataset& data, const PruneOptions& options,
                              const std::filesystem::path& out, bool resume, const nlohmann::ordered_json& config) {
   const std::string where = model_path.string();
-  if (!is_model_file(model_path)) throw Error(where, "not a trained model file (cgsr prune needs trained weights)");
-  Model input = load_model(model_path);
-  const std::string name =
-      options.name.empty() ? input.provenance.extra.value("name", model_path.stem().string()) : options.name;
+  std::string name;
+  Model input = load_prunable(model_path, data, options, name);
   const int scale = input.network->spec().scale;
-  if (find_units(input.network->describe(false)).empty())
-    throw Error(where, "the network has no layer groups that can be pruned per frame");
   const auto train_frames = data.frames(Split::Train);
-  if (train_frames.empty()) throw Error(data.info().root.string(), "the data set has no training frames");
   spdlog::info("pruning {} ({}): {} patterns of keep rates {}", name, spec_summary(input.network->spec()),
                options.pool.keep_rates.size(), nlohmann::json(options.pool.keep_rates).dump());
   PruneRoles roles;
@@ -208,10 +268,7 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   DynamicPruning dynamic(net, data, pool, options.sampler);
   TrainSchedule schedule = options.finetune.schedule;
   schedule.steps = finetune_steps(options.finetune, data, scale);
-  spdlog::info("fine-tuning {} nested patterns: {} steps ({} epochs)", pool.size(), schedule.steps,
-               options.finetune.epochs);
-  Trainer finetune(net, data, schedule, options.finetune.loss, {}, dynamic.hooks(options.finetune));
-  const TrainOutcome hybrid_training = finetune.run(out / "finetune_hybrid.pt", resume);
+  const TrainOutcome hybrid_training = finetune_patterns(net, dynamic, data, options, schedule, out, resume);
 
   // 3. The per-frame choice.
   const SelectorFit fit = dynamic.fit_selector(spread_frames(train_frames, options.selector.frames), options.selector);
@@ -263,39 +320,10 @@ nlohmann::ordered_json prune(const std::filesystem::path& model_path, const Data
   results["roles"] = to_json(roles);
 
   // 6. Held-out evaluation through the same code path as `cgsr eval`.
-  std::vector<EvalResult> evaluations;
-  {
-    NetworkUpscaler dense(name, load_model(model_path).network);
-    evaluations.push_back(evaluate(dense, data, options.eval));
-  }
-  for (const auto& b : roles.baselines) {
-    NetworkUpscaler baseline(b.name, load_model(b.file).network);
-    evaluations.push_back(evaluate(baseline, data, options.eval));
-  }
-  {
-    NetworkUpscaler static_only(roles.static_network.name, pruned.network);
-    evaluations.push_back(evaluate(static_only, data, options.eval));
-  }
-  {
-    HybridUpscaler from_file(roles.hybrid.name, load_hybrid_model(roles.hybrid.file));
-    evaluations.push_back(evaluate(from_file, data, options.eval));
-    // Per pattern, the evaluated frames that chose it (the upscaler also ran frames before them,
-    // for the temporal error).
-    std::vector<int> usage(hybrid.pool.size(), 0);
-    if (const auto choices = pattern_choices(evaluations.back()))
-      for (const auto& [k, n] : choices->usage) usage.at(k) = n;
-    results["test_selected_per_pattern"] = usage;
-  }
-  results["evaluations"] = nlohmann::ordered_json::array();
-  results["comparison"] = nlohmann::ordered_json::array();
-  for (const auto& r : evaluations) {
-    results["evaluations"].push_back(to_json(r));
-    results["comparison"].push_back(against(r, evaluations.front()));
-    spdlog::info("{}: PSNR {:.3f} dB, SSIM {:.4f}, params {}, MACs {}{}", r.name, r.psnr, r.ssim,
-                 r.cost ? format_count(static_cast<double>(r.cost->params)) : "-",
-                 r.cost ? format_count(static_cast<double>(r.cost->macs)) : "-",
-                 r.latency ? ", " + std::to_string(r.latency->median_ms) + " ms" : "");
-  }
+  std::vector<int> test_usage;
+  const auto evaluations = evaluate_roles(roles, pruned, hybrid.pool.size(), data, options.eval, test_usage);
+  results["test_selected_per_pattern"] = test_usage;
+  add_evaluations(results, evaluations);
   return results;
 }
 

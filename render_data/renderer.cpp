@@ -60,16 +60,10 @@ SceneRenderer::SceneRenderer(const Scene& scene, const RenderSettings& settings)
   shader_ = std::make_unique<BlinnPhongShader>(s, shadow_maps_);
 }
 
-GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous, int width, int height,
-                              float near_plane, float far_plane) const {
-  if (width <= 0 || height <= 0) throw Error("render", "image size must be positive");
-  RenderContext ctx;
-  ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane);
-  ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);
-  const SceneGeometry& g = geometry_;
-  const Scene& scene = g.scene();
+namespace {
 
-  // Vertex stage: world -> clip space of the current camera.
+// Vertex stage: world -> clip space of the current camera.
+void transform_vertices(const SceneGeometry& g, RenderContext& ctx) {
   const size_t nv = g.vertex_count();
   ctx.clip.resize(nv);
   ctx.depth.resize(nv);
@@ -80,8 +74,11 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
       ctx.depth[v] = ctx.clip[v].w;
     }
   });
+}
 
-  // Triangle setup and rasterization: pixel space, near plane at w = near.
+// Triangle setup and rasterization: pixel space, near plane at w = near.
+void rasterize_geometry(const SceneGeometry& g, float near_plane, int width, int height, int tile_size,
+                        RenderContext& ctx) {
   RasterInput in;
   in.clip = &ctx.clip;
   in.depth = &ctx.depth;
@@ -91,33 +88,132 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
   in.w_min = near_plane;
   in.width = width;
   in.height = height;
-  in.tile_size = settings_.tile_size;
+  in.tile_size = tile_size;
   ctx.triangles = setup_triangles(in);
   rasterize(in, ctx.triangles, ctx.visibility,
             [&g](const ScreenTriangle& t, double x, double y) { return g.alpha_covers(t, x, y); });
+}
 
-  GBuffer& out = ctx.target;
-  out.width = width;
-  out.height = height;
-  out.color = torch::empty({3, height, width}, torch::kFloat32);
-  out.depth = torch::empty({1, height, width}, torch::kFloat32);
-  out.normal = torch::empty({3, height, width}, torch::kFloat32);
-  out.normal_angle = torch::empty({1, height, width}, torch::kFloat32);
-  out.object_id = torch::empty({1, height, width}, torch::kInt32);
-  out.material_id = torch::empty({1, height, width}, torch::kInt32);
-  out.motion = torch::empty({2, height, width}, torch::kFloat32);
-  const size_t plane = static_cast<size_t>(width) * height;
-  float* color = out.color.data_ptr<float>();
-  float* depth = out.depth.data_ptr<float>();
-  float* normal = out.normal.data_ptr<float>();
-  float* angle = out.normal_angle.data_ptr<float>();
-  int32_t* object = out.object_id.data_ptr<int32_t>();
-  int32_t* material = out.material_id.data_ptr<int32_t>();
-  float* motion = out.motion.data_ptr<float>();
+// The G-buffer's planes, allocated at width x height, as raw pointers for the per-pixel writes.
+struct GBufferPlanes {
+  GBufferPlanes(GBuffer& out, int width, int height) {
+    out.width = width;
+    out.height = height;
+    out.color = torch::empty({3, height, width}, torch::kFloat32);
+    out.depth = torch::empty({1, height, width}, torch::kFloat32);
+    out.normal = torch::empty({3, height, width}, torch::kFloat32);
+    out.normal_angle = torch::empty({1, height, width}, torch::kFloat32);
+    out.object_id = torch::empty({1, height, width}, torch::kInt32);
+    out.material_id = torch::empty({1, height, width}, torch::kInt32);
+    out.motion = torch::empty({2, height, width}, torch::kFloat32);
+    plane = static_cast<size_t>(width) * height;
+    color = out.color.data_ptr<float>();
+    depth = out.depth.data_ptr<float>();
+    normal = out.normal.data_ptr<float>();
+    angle = out.normal_angle.data_ptr<float>();
+    object = out.object_id.data_ptr<int32_t>();
+    material = out.material_id.data_ptr<int32_t>();
+    motion = out.motion.data_ptr<float>();
+  }
+  size_t plane = 0;
+  float* color;
+  float* depth;
+  float* normal;
+  float* angle;
+  int32_t* object;
+  int32_t* material;
+  float* motion;
+};
+
+// No geometry (or a sky surface) at pixel p: the sky at infinity, moving with camera rotation
+// only. Returns its linear colour.
+Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlanes& px, size_t p, float cx, float cy) {
+  const Vec3 ray = pixel_ray(ctx.camera, cx, cy);
+  const Vec3 linear = sky_color(scene.sky, ray);
+  px.depth[p] = std::numeric_limits<float>::infinity();
+  for (int c = 0; c < 3; ++c) px.normal[c * px.plane + p] = 0;
+  px.angle[p] = 0;
+  px.object[p] = px.material[p] = -1;
+  const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx, cy);
+  px.motion[p] = m.x;
+  px.motion[px.plane + p] = m.y;
+  return linear;
+}
+
+// A surface at pixel p: its shaded linear colour (with fog), returned, and its view-space depth,
+// normal and angle, ids and motion written.
+Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
+                     const ScreenTriangle& tri, const Material& mat, const GBufferPlanes& px, size_t p, float cx,
+                     float cy) {
   const FrameCamera& cam = ctx.camera;
-  const float inf = std::numeric_limits<float>::infinity();
+  const Scene& scene = g.scene();
+  // World space: perspective-correct interpolation of the original triangle's vertices.
+  float b[3];
+  tri.original_barycentrics(cx, cy, b);
+  const uint32_t* idx = &g.indices[static_cast<size_t>(tri.triangle) * 3];
+  auto interp3 = [&](const std::vector<Vec3>& a) { return a[idx[0]] * b[0] + a[idx[1]] * b[1] + a[idx[2]] * b[2]; };
+  const Vec3 world = interp3(g.positions);
+  Vec3 n = normalize(interp3(g.normals));
+  if (!tri.front_facing) n = -n;  // two-sided surface seen from behind
+  const Vec3 to_eye = normalize(cam.pose.position - world);
+  if (length(n) == 0) n = to_eye;
+
+  SurfacePoint s;
+  s.position = world;
+  s.normal = n;
+  s.to_eye = to_eye;
+  s.material = &mat;
+  s.albedo = mat.tint * interp3(g.colors);
+  if (mat.albedo_texture >= 0) {
+    const UvFootprint f = uv_footprint(g, tri, cx, cy);
+    const LinearRgba t = g.textures[mat.albedo_texture].sample_trilinear(f.uv, f.duv_dx, f.duv_dy);
+    s.albedo = s.albedo * Vec3{t.r, t.g, t.b};
+  }
+  if (mat.lightmap_texture >= 0) {
+    const Vec2 lm = g.lightmap_uvs[idx[0]] * b[0] + g.lightmap_uvs[idx[1]] * b[1] + g.lightmap_uvs[idx[2]] * b[2];
+    const LinearRgba t = g.textures[mat.lightmap_texture].sample_bilinear_clamped(lm);
+    s.lightmap = {t.r, t.g, t.b};
+  }
+  Vec3 linear = shader.shade(s);
+  if (scene.fog.density > 0) {
+    const float dist = length(world - cam.pose.position);
+    const float f = 1.0f - std::exp(-scene.fog.density * std::max(0.0f, dist - scene.fog.start));
+    linear = lerp(linear, scene.fog.color, f);
+  }
+
+  // View space: depth, normal and its angle to the direction towards the camera.
+  px.depth[p] = ctx.visibility.depth[p];
+  const Vec3 nv = normalize(cam.view.transform_direction(n));
+  const Vec3 pv = cam.view.transform_point(world);
+  const float cos_a = std::clamp(dot(nv, normalize(-pv)), -1.0f, 1.0f);
+  px.normal[p] = nv.x;
+  px.normal[px.plane + p] = nv.y;
+  px.normal[2 * px.plane + p] = nv.z;
+  px.angle[p] = std::min(1.0f, std::acos(cos_a) / kHalfPi);
+  const Mesh& mesh = g.mesh_of(tri.triangle);
+  px.object[p] = mesh.object_id;
+  px.material[p] = mesh.material;
+  const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx, cy);
+  px.motion[p] = m.x;
+  px.motion[px.plane + p] = m.y;
+  return linear;
+}
+
+}  // namespace
+
+GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous, int width, int height,
+                              float near_plane, float far_plane) const {
+  if (width <= 0 || height <= 0) throw Error("render", "image size must be positive");
+  RenderContext ctx;
+  ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane);
+  ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);
+  const SceneGeometry& g = geometry_;
+  transform_vertices(g, ctx);
+  rasterize_geometry(g, near_plane, width, height, settings_.tile_size, ctx);
 
   // Resolve: one shading per visible pixel, tile by tile.
+  GBuffer& out = ctx.target;
+  const GBufferPlanes px(out, width, height);
   const int ts = settings_.tile_size;
   tbb::parallel_for(tbb::blocked_range2d<int>(0, height, ts, 0, width, ts), [&](const tbb::blocked_range2d<int>& r) {
     for (int i = r.rows().begin(); i < r.rows().end(); ++i)
@@ -127,72 +223,11 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
         const int32_t si = ctx.visibility.screen_index[p];
         const ScreenTriangle* tri = si >= 0 ? &ctx.triangles[si] : nullptr;
         const Material* mat = tri ? &g.material_of(tri->triangle) : nullptr;
-        Vec3 linear;
-        if (!tri || mat->sky) {
-          // No geometry (or a sky surface): the sky at infinity, moving with camera rotation only.
-          const Vec3 ray = pixel_ray(cam, cx, cy);
-          linear = sky_color(scene.sky, ray);
-          depth[p] = inf;
-          for (int c = 0; c < 3; ++c) normal[c * plane + p] = 0;
-          angle[p] = 0;
-          object[p] = material[p] = -1;
-          const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx, cy);
-          motion[p] = m.x;
-          motion[plane + p] = m.y;
-        } else {
-          // World space: perspective-correct interpolation of the original triangle's vertices.
-          float b[3];
-          tri->original_barycentrics(cx, cy, b);
-          const uint32_t* idx = &g.indices[static_cast<size_t>(tri->triangle) * 3];
-          auto interp3 = [&](const std::vector<Vec3>& a) { return a[idx[0]] * b[0] + a[idx[1]] * b[1] + a[idx[2]] * b[2]; };
-          const Vec3 world = interp3(g.positions);
-          Vec3 n = normalize(interp3(g.normals));
-          if (!tri->front_facing) n = -n;  // two-sided surface seen from behind
-          const Vec3 to_eye = normalize(cam.pose.position - world);
-          if (length(n) == 0) n = to_eye;
-
-          SurfacePoint s;
-          s.position = world;
-          s.normal = n;
-          s.to_eye = to_eye;
-          s.material = mat;
-          s.albedo = mat->tint * interp3(g.colors);
-          if (mat->albedo_texture >= 0) {
-            const UvFootprint f = uv_footprint(g, *tri, cx, cy);
-            const LinearRgba t = g.textures[mat->albedo_texture].sample_trilinear(f.uv, f.duv_dx, f.duv_dy);
-            s.albedo = s.albedo * Vec3{t.r, t.g, t.b};
-          }
-          if (mat->lightmap_texture >= 0) {
-            const Vec2 lm = g.lightmap_uvs[idx[0]] * b[0] + g.lightmap_uvs[idx[1]] * b[1] + g.lightmap_uvs[idx[2]] * b[2];
-            const LinearRgba t = g.textures[mat->lightmap_texture].sample_bilinear_clamped(lm);
-            s.lightmap = {t.r, t.g, t.b};
-          }
-          linear = shader_->shade(s);
-          if (scene.fog.density > 0) {
-            const float dist = length(world - cam.pose.position);
-            const float f = 1.0f - std::exp(-scene.fog.density * std::max(0.0f, dist - scene.fog.start));
-            linear = lerp(linear, scene.fog.color, f);
-          }
-
-          // View space: depth, normal and its angle to the direction towards the camera.
-          depth[p] = ctx.visibility.depth[p];
-          const Vec3 nv = normalize(cam.view.transform_direction(n));
-          const Vec3 pv = cam.view.transform_point(world);
-          const float cos_a = std::clamp(dot(nv, normalize(-pv)), -1.0f, 1.0f);
-          normal[p] = nv.x;
-          normal[plane + p] = nv.y;
-          normal[2 * plane + p] = nv.z;
-          angle[p] = std::min(1.0f, std::acos(cos_a) / kHalfPi);
-          const Mesh& mesh = g.mesh_of(tri->triangle);
-          object[p] = mesh.object_id;
-          material[p] = mesh.material;
-          const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx, cy);
-          motion[p] = m.x;
-          motion[plane + p] = m.y;
-        }
-        color[p] = encode_srgb(linear.x);
-        color[plane + p] = encode_srgb(linear.y);
-        color[2 * plane + p] = encode_srgb(linear.z);
+        const Vec3 linear = !tri || mat->sky ? resolve_sky(ctx, g.scene(), px, p, cx, cy)
+                                             : resolve_surface(ctx, g, *shader_, *tri, *mat, px, p, cx, cy);
+        px.color[p] = encode_srgb(linear.x);
+        px.color[px.plane + p] = encode_srgb(linear.y);
+        px.color[2 * px.plane + p] = encode_srgb(linear.z);
       }
   });
 

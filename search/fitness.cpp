@@ -8,21 +8,29 @@ namespace cgsr {
 
 config::Schema<FitnessOptions> fitness_schema() {
   config::Schema<FitnessOptions> s;
-  s.field("size_metric", &FitnessOptions::size_metric, "what counts as size").one_of({"params", "macs", "latency"});
+  s.field("size_metric", &FitnessOptions::size_metric, "what counts as size");
   s.field("size_weight", &FitnessOptions::size_weight, "weight of the relative size").at_least(0);
   s.field("geometry_weight", &FitnessOptions::geometry_weight, "weight of the geometry loss in the joint loss")
       .at_least(0);
   return s;
 }
 
-double size_of(const CandidateScore& score, const std::string& metric) {
-  if (metric == "params") return static_cast<double>(score.params);
-  if (metric == "macs") return static_cast<double>(score.macs);
-  if (metric == "latency") {
-    if (!score.latency_ms) throw Error("fitness", "size_metric latency needs measured latencies", ErrorKind::Internal);
-    return *score.latency_ms;
+const std::vector<std::string>& EnumNames<SizeMetric>::names() {
+  static const std::vector<std::string> names = {"params", "macs", "latency"};
+  return names;
+}
+
+double size_of(const CandidateScore& score, SizeMetric metric) {
+  switch (metric) {
+    case SizeMetric::Params:
+      return static_cast<double>(score.params);
+    case SizeMetric::Macs:
+      return static_cast<double>(score.macs);
+    case SizeMetric::Latency:
+      if (!score.latency_ms) throw Error("fitness", "size_metric latency needs measured latencies", ErrorKind::Internal);
+      return *score.latency_ms;
   }
-  throw Error("fitness", "unknown size metric '" + metric + "'");
+  throw Error("fitness", "unknown size metric", ErrorKind::Internal);
 }
 
 double fitness(const CandidateScore& candidate, const CandidateScore& parent, const FitnessOptions& options) {

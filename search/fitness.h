@@ -11,14 +11,22 @@
 
 namespace cgsr {
 
+// What counts as a candidate's size: params, macs or (measured) latency.
+enum class SizeMetric { Params, Macs, Latency };
+template <>
+struct EnumNames<SizeMetric> {
+  static constexpr const char* kind = "size metric";
+  static const std::vector<std::string>& names();
+};
+
 struct FitnessOptions {
-  std::string size_metric = "params";  // params | macs | latency
+  SizeMetric size_metric = SizeMetric::Params;
   double size_weight = 0.5;
   double geometry_weight = 0.1;
 };
 config::Schema<FitnessOptions> fitness_schema();
 
 double fitness(const CandidateScore& candidate, const CandidateScore& parent, const FitnessOptions& options);
-double size_of(const CandidateScore& score, const std::string& metric);
+double size_of(const CandidateScore& score, SizeMetric metric);
 
 }  // namespace cgsr

@@ -12,17 +12,51 @@
 
 namespace cgsr {
 
+namespace {
+// Before each strategy had its own options block, evolution's options were a shared `operators:`
+// block next to `strategy: evolution`; they now sit in the strategy block.
+YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cursor& at) {
+  if (!map || !map.IsMap() || !map["operators"] || !map["operators"].IsMap()) return map;
+  const YAML::Node operators = map["operators"];
+  YAML::Node strategy(YAML::NodeType::Map);
+  const YAML::Node given = map["strategy"];
+  if (given && given.IsMap())
+    for (const auto& kv : given) strategy.force_insert(kv.first, kv.second);
+  else
+    strategy["type"] = given && given.IsScalar() ? given : YAML::Node("evolution");
+  const bool evolution = strategy["type"].IsScalar() && strategy["type"].Scalar() == "evolution";
+  const std::string where = at.doc ? at.doc->locate(operators) : at.child("operators").path;
+  config::warn_deprecated(where, "'" + at.child("operators").path + "' is deprecated: " +
+                                     (evolution ? "write its keys in the strategy block, '" + at.child("strategy").path +
+                                                      ": {type: evolution, mutation_rate: ...}'"
+                                                : std::string("only the evolution strategy has these options; they are ignored")));
+  if (evolution)
+    for (const auto& kv : operators) strategy.force_insert(kv.first, kv.second);
+
+  YAML::Node out(YAML::NodeType::Map);
+  for (const auto& kv : map) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "";
+    if (key == "operators") continue;
+    out.force_insert(kv.first, key == "strategy" ? strategy : kv.second);
+  }
+  if (!given) out["strategy"] = strategy;
+  return out;
+}
+}  // namespace
+
 config::Schema<SearchOptions> search_schema() {
   config::Schema<SearchOptions> s;
-  s.field("strategy", &SearchOptions::strategy, "search strategy").one_of(strategy_registry().names());
+  s.field("strategy", &SearchOptions::strategy,
+          "proposes the candidates: {type: evolution, initial_spread, mutation_rate, crossover_rate} or {type: random}"
+          " (a bare name takes the strategy's defaults)");
   s.field("population", &SearchOptions::population, "P: new candidates per generation").range(1, 10000);
   s.field("selection_ratio", &SearchOptions::selection_ratio, "H = ratio x P candidates survive").range(0.01, 1.0);
   s.field("generations", &SearchOptions::generations, "generation limit").range(1, 10000);
   s.field("min_candidates", &SearchOptions::min_candidates, "stop when fewer unseen candidates remain").at_least(1);
   s.field("tolerance_db", &SearchOptions::tolerance_db, "pick: validation PSNR within this of the parent").at_least(0);
   s.section("space", &SearchOptions::space, search_space_schema(), "what the search may change");
-  s.section("operators", &SearchOptions::operators, strategy_schema(), "mutation and crossover");
   s.section("fitness", &SearchOptions::fitness, fitness_schema(), "how candidates are ranked");
+  s.upgrade(move_operators_into_strategy);
   return s;
 }
 
@@ -59,7 +93,7 @@ std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates) {
 SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
                         const SearchOptions& options) {
   const SearchSpace space(parent_spec, options.space, evaluator.block_drop_order());
-  auto strategy = strategy_registry().get(options.strategy)(space, options.operators);
+  auto strategy = strategy_registry().get(options.strategy.type).make(space, options.strategy);
   SearchResult result;
 
   // The parent, validated once: the reference for fitness and the pick rule.

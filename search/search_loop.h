@@ -23,14 +23,13 @@
 namespace cgsr {
 
 struct SearchOptions {
-  std::string strategy = "evolution";
+  StrategyOptions strategy;       // {type: evolution, ...its options} or a bare name
   int population = 50;            // P: new candidates per generation
   double selection_ratio = 0.2;   // H = ratio x P survive
   int generations = 10;
   int min_candidates = 2;
   double tolerance_db = 0.05;     // pick rule: PSNR within this of the parent
   SearchSpaceOptions space;
-  StrategyOptions operators;
   FitnessOptions fitness;
 };
 config::Schema<SearchOptions> search_schema();

@@ -4,12 +4,12 @@
 
 namespace cgsr {
 
-config::Schema<StrategyOptions> strategy_schema() {
-  config::Schema<StrategyOptions> s;
-  s.field("initial_spread", &StrategyOptions::initial_spread, "per-gene mutation rate of the first generation")
+config::Schema<EvolutionOptions> evolution_schema() {
+  config::Schema<EvolutionOptions> s;
+  s.field("initial_spread", &EvolutionOptions::initial_spread, "per-gene mutation rate of the first generation")
       .range(0, 1);
-  s.field("mutation_rate", &StrategyOptions::mutation_rate, "per-gene mutation rate").range(0, 1);
-  s.field("crossover_rate", &StrategyOptions::crossover_rate, "share of children made by crossover").range(0, 1);
+  s.field("mutation_rate", &EvolutionOptions::mutation_rate, "per-gene mutation rate").range(0, 1);
+  s.field("crossover_rate", &EvolutionOptions::crossover_rate, "share of children made by crossover").range(0, 1);
   return s;
 }
 
@@ -32,7 +32,7 @@ std::vector<ArchSpec> collect(int count, const SearchSpace& space, const std::fu
 
 class Evolution : public SearchStrategy {
  public:
-  Evolution(const SearchSpace& space, StrategyOptions options) : space_(space), options_(options) {}
+  Evolution(const SearchSpace& space, EvolutionOptions options) : space_(space), options_(options) {}
   std::vector<ArchSpec> propose(const std::vector<Candidate>& survivors, int count,
                                 const std::function<bool(const std::string&)>& seen, std::mt19937_64& rng) override {
     std::uniform_real_distribution<double> u(0, 1);
@@ -51,7 +51,7 @@ class Evolution : public SearchStrategy {
 
  private:
   const SearchSpace& space_;
-  StrategyOptions options_;
+  EvolutionOptions options_;
 };
 
 class RandomSearch : public SearchStrategy {
@@ -67,13 +67,28 @@ class RandomSearch : public SearchStrategy {
 };
 }  // namespace
 
-const Registry<StrategyFactory>& strategy_registry() {
-  static const Registry<StrategyFactory> registry = [] {
-    Registry<StrategyFactory> r("search strategy");
+const Registry<StrategyType>& strategy_registry() {
+  static const Registry<StrategyType> registry = [] {
+    Registry<StrategyType> r("search strategy");
     r.add("evolution",
-          [](const SearchSpace& space, const StrategyOptions& o) { return std::make_unique<Evolution>(space, o); },
+          {[](const YAML::Node& block, StrategyOptions& o, const config::Cursor& at) {
+             evolution_schema().parse(block, o.evolution, at, {"type"});
+           },
+           [](const StrategyOptions& o, YAML::Node& block) {
+             for (const auto& kv : evolution_schema().emit(o.evolution)) block[kv.first] = kv.second;
+           },
+           [](const SearchSpace& space, const StrategyOptions& o) {
+             return std::make_unique<Evolution>(space, o.evolution);
+           }},
           "mutation and crossover of the survivors (CGSR)");
-    r.add("random", [](const SearchSpace& space, const StrategyOptions&) { return std::make_unique<RandomSearch>(space); },
+    r.add("random",
+          {[](const YAML::Node& block, StrategyOptions&, const config::Cursor& at) {
+             for (const auto& kv : block)
+               if (!kv.first.IsScalar() || kv.first.Scalar() != "type")
+                 at.fail(kv.first, "the random strategy has no options; only 'type' belongs here");
+           },
+           [](const StrategyOptions&, YAML::Node&) {},
+           [](const SearchSpace& space, const StrategyOptions&) { return std::make_unique<RandomSearch>(space); }},
           "uniform samples of the search space (baseline)");
     return r;
   }();
@@ -81,3 +96,35 @@ const Registry<StrategyFactory>& strategy_registry() {
 }
 
 }  // namespace cgsr
+
+namespace cgsr::config {
+
+StrategyOptions Codec<StrategyOptions>::decode(const YAML::Node& n, const Cursor& at) {
+  const auto& registry = strategy_registry();
+  const auto known_type = [&](const YAML::Node& name, const Cursor& where) {
+    const std::string type = Codec<std::string>::decode(name, where);
+    if (!registry.contains(type))
+      where.fail(name, "unknown " + registry.kind() + " '" + type + "'" + did_you_mean(type, registry.names()) +
+                           "; valid: " + join(registry.names()));
+    return type;
+  };
+  StrategyOptions o;
+  if (n.IsScalar()) {
+    o.type = known_type(n, at);
+    return o;
+  }
+  if (!n.IsMap()) at.fail(n, "expected a strategy name or a block {type: Name, ...}, got " + detail::describe(n));
+  if (!n["type"]) at.fail(n, "missing required key 'type' (one of: " + join(registry.names()) + ")");
+  o.type = known_type(n["type"], at.child("type"));
+  registry.get(o.type).parse_options(n, o, at);
+  return o;
+}
+
+YAML::Node Codec<StrategyOptions>::encode(const StrategyOptions& o) {
+  YAML::Node block(YAML::NodeType::Map);
+  block["type"] = o.type;
+  strategy_registry().get(o.type).emit_options(o, block);
+  return block;
+}
+
+}  // namespace cgsr::config

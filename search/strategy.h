@@ -1,6 +1,8 @@
 #pragma once
-// Search strategies propose new specs from the survivors of the previous generation. They see
-// specs and fitness values only (search/evaluator.h); a registry builds them by name:
+// Search strategies propose new specs from the survivors of the previous generation: selection,
+// mutation and crossover live here, the generation loop (search/search_loop.h) keeps the
+// generations, history and pick. They see specs and fitness values only (search/evaluator.h);
+// a registry builds them by name, each with its own options block:
 //   evolution  mutation and crossover of the survivors' genes (the CGSR search)
 //   random     specs drawn uniformly from the space (the baseline at equal budget)
 
@@ -25,12 +27,20 @@ struct Candidate {
   int generation = 0;
 };
 
-struct StrategyOptions {
+// Options of the evolution strategy (the CGSR search).
+struct EvolutionOptions {
   double initial_spread = 0.5;  // mutation rate that draws the first generation around the parent
   double mutation_rate = 0.15;  // per gene
   double crossover_rate = 0.5;  // share of children made by crossover of two survivors
 };
-config::Schema<StrategyOptions> strategy_schema();
+config::Schema<EvolutionOptions> evolution_schema();
+
+// The strategy and its own options block: `strategy: {type: evolution, mutation_rate: 0.2}`, or
+// a bare name (`strategy: random`) for a strategy with its defaults.
+struct StrategyOptions {
+  std::string type = "evolution";
+  EvolutionOptions evolution;  // read when type is evolution
+};
 
 class SearchStrategy {
  public:
@@ -42,8 +52,21 @@ class SearchStrategy {
                                         std::mt19937_64& rng) = 0;
 };
 
-using StrategyFactory =
-    std::function<std::unique_ptr<SearchStrategy>(const SearchSpace& space, const StrategyOptions& options)>;
-const Registry<StrategyFactory>& strategy_registry();
+// A strategy by name: how its options block is read and written, and the factory.
+struct StrategyType {
+  std::function<void(const YAML::Node& block, StrategyOptions& options, const config::Cursor& at)> parse_options;
+  std::function<void(const StrategyOptions& options, YAML::Node& block)> emit_options;
+  std::function<std::unique_ptr<SearchStrategy>(const SearchSpace& space, const StrategyOptions& options)> make;
+};
+const Registry<StrategyType>& strategy_registry();
 
 }  // namespace cgsr
+
+namespace cgsr::config {
+// `strategy:` as a bare name or a {type: Name, ...its options} block; written as the block.
+template <>
+struct Codec<StrategyOptions> {
+  static StrategyOptions decode(const YAML::Node& n, const Cursor& at);
+  static YAML::Node encode(const StrategyOptions& o);
+};
+}  // namespace cgsr::config

@@ -22,13 +22,7 @@ namespace cgsr {
 
 config::Schema<AblationOptions> ablation_schema_fields() {
   config::Schema<AblationOptions> s;
-  s.field("sources", &AblationOptions::sources, "RIT sources to compare (rit.h)").check(
-      [](const std::vector<std::string>& v) {
-        return std::all_of(v.begin(), v.end(), [](const std::string& x) {
-          return std::find(rit_sources().begin(), rit_sources().end(), x) != rit_sources().end();
-        });
-      },
-      "must name RIT sources: " + join(rit_sources(), ", "));
+  s.field("sources", &AblationOptions::sources, "RIT sources to compare (rit.h)");
   s.section("rit", &AblationOptions::rit, rit_spec_schema(), "the RIT of every CG-enhanced variant");
   s.field("leave_out", &AblationOptions::leave_out, "the best source with each rendering channel left out in turn");
   s.field("small_width", &AblationOptions::small_width, "width factor of the small networks (0 = none)").range(0, 1);
@@ -54,7 +48,7 @@ std::string slug(const std::string& name) {
   return out;
 }
 
-ArchSpec with_source(ArchSpec spec, const RitSpec& rit, const std::string& source) {
+ArchSpec with_source(ArchSpec spec, const RitSpec& rit, RitSource source) {
   spec.rit = rit;
   spec.rit.enabled = true;
   spec.rit.source = source;
@@ -196,27 +190,27 @@ AblationResult run_ablation(const SRNetworkImpl& parent, const Dataset& data, co
   result.rows.push_back(runner.run({"plain (control)", "control", plain}));
 
   double best_val = -1e300;
-  for (const auto& source : options.sources) {
-    result.rows.push_back(runner.run({source, "source", with_source(plain, options.rit, source)}));
+  RitSource best = RitSource::Lr;
+  for (const auto source : options.sources) {
+    result.rows.push_back(runner.run({enum_name(source), "source", with_source(plain, options.rit, source)}));
     const double val = mean(result.rows.back().val_psnr);
     if (val > best_val) {
       best_val = val;
-      result.best_source = source;
+      best = source;
+      result.best_source = enum_name(source);
     }
   }
   if (!result.best_source.empty() && options.leave_out && options.rit.channels.size() > 1)
     for (const auto& channel : options.rit.channels) {
       RitSpec rit = options.rit;
       rit.channels.erase(std::find(rit.channels.begin(), rit.channels.end(), channel));
-      result.rows.push_back(runner.run({result.best_source + " - " + channel, "leave_out",
-                                        with_source(plain, rit, result.best_source)}));
+      result.rows.push_back(runner.run({result.best_source + " - " + channel, "leave_out", with_source(plain, rit, best)}));
     }
   if (options.small_width > 0) {
     const ArchSpec small = shrunk(plain, options.small_width);
     result.rows.push_back(runner.run({"small plain", "small", small}));
     if (!result.best_source.empty())
-      result.rows.push_back(runner.run(
-          {"small + " + result.best_source, "small", with_source(small, options.rit, result.best_source)}));
+      result.rows.push_back(runner.run({"small + " + result.best_source, "small", with_source(small, options.rit, best)}));
   }
   return result;
 }

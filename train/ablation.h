@@ -36,7 +36,8 @@
 namespace cgsr {
 
 struct AblationOptions {
-  std::vector<std::string> sources = rit_sources();
+  std::vector<RitSource> sources = {RitSource::Lr, RitSource::HrPooled, RitSource::HrUnshuffle, RitSource::HrFuse,
+                                    RitSource::HrUnshuffleHrFuse};
   RitSpec rit;               // every CG variant's RIT (channels, widths, fusion, depth encoding)
   bool leave_out = true;     // the best source with each channel left out in turn
   double small_width = 0.5;  // width factor of the small networks; 0 = none

@@ -8,8 +8,8 @@ namespace cgsr {
 
 config::Schema<LossOptions> loss_schema() {
   config::Schema<LossOptions> s;
-  s.field("image_norm", &LossOptions::image_norm, "norm of the image term").one_of({"l2", "l1"});
-  s.field("geometry_norm", &LossOptions::geometry_norm, "norm of the geometry term").one_of({"l2", "l1"});
+  s.field("image_norm", &LossOptions::image_norm, "norm of the image term");
+  s.field("geometry_norm", &LossOptions::geometry_norm, "norm of the geometry term");
   s.field("lambda_geometry", &LossOptions::lambda_geometry, "weight of the geometry term (needs a geometry head)")
       .at_least(0);
   s.field("lambda_rit", &LossOptions::lambda_rit, "weight of the L1 norm of the RIT gates").at_least(0);
@@ -18,10 +18,13 @@ config::Schema<LossOptions> loss_schema() {
   return s;
 }
 
-torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, const std::string& norm) {
-  if (norm == "l1") return torch::l1_loss(output, target);
-  if (norm == "l2") return torch::mse_loss(output, target);
-  throw Error("loss", "unknown norm '" + norm + "' (l1 or l2)");
+const std::vector<std::string>& EnumNames<ErrorNorm>::names() {
+  static const std::vector<std::string> names = {"l2", "l1"};
+  return names;
+}
+
+torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, ErrorNorm norm) {
+  return norm == ErrorNorm::L1 ? torch::l1_loss(output, target) : torch::mse_loss(output, target);
 }
 
 LossTerms cgsr_loss(const SRNetworkImpl& net, const TrainOutput& output, const Batch& batch,

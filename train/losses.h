@@ -17,9 +17,17 @@
 
 namespace cgsr {
 
+// Mean squared (l2) or mean absolute (l1) error.
+enum class ErrorNorm { L2, L1 };
+template <>
+struct EnumNames<ErrorNorm> {
+  static constexpr const char* kind = "error norm";
+  static const std::vector<std::string>& names();
+};
+
 struct LossOptions {
-  std::string image_norm = "l2";     // l2 | l1
-  std::string geometry_norm = "l2";  // l2 | l1
+  ErrorNorm image_norm = ErrorNorm::L2;
+  ErrorNorm geometry_norm = ErrorNorm::L2;
   double lambda_geometry = 0.1;
   double lambda_rit = 1e-4;
   double lambda_shrink = 1e-4;
@@ -37,7 +45,7 @@ struct LossTerms {
 LossTerms cgsr_loss(const SRNetworkImpl& net, const TrainOutput& output, const Batch& batch,
                     const LossOptions& options, const ShrinkTargets& shrink = {});
 
-// Mean squared or mean absolute error, by name ("l2" | "l1").
-torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, const std::string& norm);
+// Mean squared (l2) or mean absolute (l1) error.
+torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, ErrorNorm norm);
 
 }  // namespace cgsr

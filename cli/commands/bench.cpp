@@ -28,9 +28,8 @@ config::Schema<BenchOptions> bench_schema() {
   s.field("batch", &BenchOptions::batch, "images per run").range(1, 64);
   s.field("warmup", &BenchOptions::warmup, "untimed runs first").range(0, 1000);
   s.field("runs", &BenchOptions::runs, "timed runs").range(1, 100000);
-  s.field("engine", &BenchOptions::engine, "inference engine: fused (oneDNN) or libtorch").one_of({"fused", "libtorch"});
-  s.field("layout", &BenchOptions::layout, "activation memory layout of the libtorch engine")
-      .one_of({"auto", "nchw", "nhwc"});
+  s.field("engine", &BenchOptions::engine, "inference engine: fused (oneDNN) or libtorch");
+  s.field("layout", &BenchOptions::layout, "activation memory layout of the libtorch engine");
   s.field("layers", &BenchOptions::layers, "also time every layer of the network");
   s.field("json", &BenchOptions::json, "print JSON instead of a table");
   s.field("onnx", &BenchOptions::onnx, "exported ONNX file to time in ONNX Runtime next to our forward pass");
@@ -131,7 +130,7 @@ BenchTarget model_target(const BenchOptions& options) {
   BenchTarget t;
   t.name = spec_summary(source.spec);
   t.macs = complexity(*net, w, h).macs * options.batch;
-  if (inference_engine_from_name(options.engine) == InferenceEngine::Fused) {
+  if (options.engine == InferenceEngine::Fused) {
     net->eval();
     auto fused = std::make_shared<FusedGraph>(net->describe());
     t.runtime = "cgsr fused";
@@ -139,7 +138,7 @@ BenchTarget model_target(const BenchOptions& options) {
     t.run = [fused, color, info] { fused->run(color, info); };
     return t;
   }
-  const MemoryLayout layout = inference_layout(*net, color, info, enum_from_name<MemoryLayout>(options.layout));
+  const MemoryLayout layout = inference_layout(*net, color, info, options.layout);
   t.runtime = "libtorch";
   t.detail = std::string("layout ") + enum_name(layout);
   t.run = [net, color, info, layout]() mutable { infer(*net, color, info, layout); };

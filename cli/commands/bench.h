@@ -14,6 +14,8 @@
 
 #include "cli/command.h"
 #include "core/timing.h"
+#include "models/inference.h"
+#include "models/memory_layout.h"
 #include "models/model_source.h"
 
 namespace cgsr::cli {
@@ -25,8 +27,8 @@ struct BenchOptions : RunSettings {
   int batch = 1;
   int warmup = 3;
   int runs = 20;
-  std::string engine = "fused";  // fused | libtorch (models/inference.h)
-  std::string layout = "auto";   // auto | nchw | nhwc: activation layout of the libtorch engine
+  InferenceEngine engine = InferenceEngine::Fused;
+  MemoryLayout layout = MemoryLayout::Auto;  // activation layout of the libtorch engine
   bool layers = false;          // also time every layer (graph interpreter, NCHW)
   bool json = false;
   std::string onnx;  // an exported ONNX file to time in ONNX Runtime on the same input

@@ -29,8 +29,7 @@ config::Schema<ExportCommandOptions> export_schema() {
   s.field("input", &ExportCommandOptions::input, "LR input size WxH");
   s.field("dynamic_size", &ExportCommandOptions::dynamic_size, "ONNX: symbolic batch, height and width");
   s.field("cubic_resize", &ExportCommandOptions::cubic_resize,
-          "ONNX: bicubic resize as a fixed conv (runs everywhere) or a native cubic Resize")
-      .one_of({"conv", "native"});
+          "ONNX: bicubic resize as a fixed conv (runs everywhere) or a native cubic Resize");
   s.field("verify", &ExportCommandOptions::verify, "verify the file in other runtimes against our forward pass");
   s.field("tolerance", &ExportCommandOptions::tolerance, "max abs error allowed by verify").range(0, 1);
   s.field("out", &ExportCommandOptions::out, "the file to write (a directory for a hybrid-pruned model)").required();
@@ -138,7 +137,7 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   o.width = w;
   o.height = h;
   o.dynamic_size = options.dynamic_size;
-  o.cubic = cubic_resize_from_name(options.cubic_resize);
+  o.cubic = options.cubic_resize;
   ModelSource source = resolve_model(options.model, options.scale);
   if (source.provenance && is_hybrid_model(*source.provenance)) return run_hybrid_export(options, o);
   SRNetwork net = source.network;

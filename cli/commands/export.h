@@ -15,6 +15,7 @@
 
 #include "cli/command.h"
 #include "export/export_format.h"
+#include "export/onnx_writer.h"
 
 namespace cgsr::cli {
 
@@ -24,7 +25,7 @@ struct ExportCommandOptions : RunSettings {
   ExportFormat format = ExportFormat::Onnx;
   std::string input = "320x240";  // LR input size WxH (written into a fixed-size ONNX file)
   bool dynamic_size = false;      // ONNX: symbolic batch, height and width
-  std::string cubic_resize = "conv";  // ONNX: bicubic resize as conv (portable) or native Resize
+  CubicResize cubic_resize = CubicResize::Conv;  // ONNX: bicubic resize as conv (portable) or native Resize
   bool verify = false;            // run the file in the other runtimes and compare with our forward
   double tolerance = 1e-4;        // max abs error allowed by --verify
   std::string out;                // the file to write

@@ -46,7 +46,8 @@ config::Schema<PipelineOptions> pipeline_schema() {
   s.field("baselines", &PipelineOptions::baselines, "classic upscalers in the report (bicubic is always there)")
       .one_of(classic_upscalers().names());
   s.block("train", &PipelineOptions::train, "cgsr train config of the plain backbone (data is filled in)");
-  s.block("enhance", &PipelineOptions::enhance, "cgsr train config of the CG-enhanced network (data, model filled in)");
+  s.block("enhance", &PipelineOptions::enhance,
+          "cgsr train config of the CG-enhanced network, its enhance block's rit and geometry at the top (data, model filled in)");
   s.block("search", &PipelineOptions::search, "cgsr search config (parent, data filled in)");
   s.block("prune", &PipelineOptions::prune, "cgsr prune config (model, data, eval filled in)");
   s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in (onnx, torchscript)");
@@ -129,12 +130,15 @@ class StageRunner {
   fs::path dir(const std::string& stage) const { return root_ / (stage == "render" ? "data" : stage); }
 
   // `body(run_dir, resume)` does the stage's work and returns its results.
+  // The hash is of `resolved`, or of `cache_form` when given (a config whose shape changed but
+  // whose meaning did not hashes as before).
   StageOutcome run(const std::string& stage, const YAML::Node& resolved, const std::vector<std::string>& upstream,
-                   const std::function<nlohmann::ordered_json(RunDir&, bool)>& body) {
+                   const std::function<nlohmann::ordered_json(RunDir&, bool)>& body,
+                   const YAML::Node& cache_form = YAML::Node()) {
     ++index_;
     forcing_ = forcing_ || stage == from_;
     StageOutcome outcome;
-    outcome.hash = stage_hash(resolved, upstream);
+    outcome.hash = stage_hash(cache_form.IsDefined() && !cache_form.IsNull() ? cache_form : resolved, upstream);
     const fs::path where = dir(stage);
     if (!forcing_ && stage_is_current(where, outcome.hash)) {
       spdlog::info("[{}/{}] {}: up to date in {}, skipped", index_, total_, stage, where.string());
@@ -235,8 +239,8 @@ class Pipeline {
         stages_(root_, options.from,
                 static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1) -
                     (options.heldout.scenes.empty() ? 1 : 0)) {
+    parse_stage_options();  // first: a mistake in a stage section is an error at its line
     results_["config"] = yaml_to_json(resolved);
-    parse_stage_options();
   }
 
   nlohmann::ordered_json run() {
@@ -290,7 +294,7 @@ class Pipeline {
     backbone_ = parse_stage(options_.train, train_schema(), with_data, "train");
     YAML::Node enhance_filled = YAML::Clone(with_data);
     enhance_filled["model"] = model_file("train").string();
-    enhanced_ = parse_stage(options_.enhance, train_schema(), enhance_filled, "enhance");
+    enhanced_ = parse_stage(options_.enhance, enhance_stage_schema(), enhance_filled, "enhance");
     enhanced_.enhance.enabled = true;
     control_ = enhanced_;  // same start, schedule, loss and seed; no rendering information
     control_.enhance.enabled = false;
@@ -340,11 +344,14 @@ class Pipeline {
 
   // CG-enhanced -> CG-optimized.
   void search() {
-    searched_ = stages_.run("search", search_command_schema().emit(search_), {data_hash_, enhanced_stage_.hash},
-                            [&](RunDir& dir, bool resume) {
-                              search_.resume = resume;
-                              return run_search_command(search_, search_command_schema().emit(search_), dir);
-                            });
+    const YAML::Node resolved = search_command_schema().emit(search_);
+    searched_ = stages_.run(
+        "search", resolved, {data_hash_, enhanced_stage_.hash},
+        [&](RunDir& dir, bool resume) {
+          search_.resume = resume;
+          return run_search_command(search_, search_command_schema().emit(search_), dir);
+        },
+        search_config_cache_form(resolved));
     record("search", searched_);
   }
 

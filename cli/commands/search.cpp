@@ -16,7 +16,8 @@ config::Schema<SearchCommandOptions> search_command_schema() {
   config::Schema<SearchCommandOptions> s;
   s.field("parent", &SearchCommandOptions::parent, "CG-enhanced model file to start from").required();
   s.field("data", &SearchCommandOptions::data, "data set directory").required();
-  s.section("search", &SearchCommandOptions::search, search_schema(), "population, selection, space, fitness");
+  s.inline_section(&SearchCommandOptions::search, search_schema());
+  s.moved_block("search");  // configs before the search options moved up: `search: {strategy: ...}`
   s.section("candidate", &SearchCommandOptions::candidate, candidate_training_schema(), "training of each candidate");
   s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
   s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
@@ -32,13 +33,50 @@ void setup_search(CLI::App& app) {
       [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
         flag_to_key(sub, flags, "--parent", "parent", "CG-enhanced model file");
         flag_to_key(sub, flags, "--data", "data", "data set directory");
-        flag_to_key(sub, flags, "--strategy", "search.strategy", "evolution or random");
+        flag_to_key(sub, flags, "--strategy", "strategy", "evolution or random (with its default options)");
         switch_to_key(sub, flags, "--resume", "resume", "continue an interrupted search in --out");
       },
       [](const SearchCommandOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
         return run_search_command(options, resolved, *run_dir);
       },
       /*always_run_dir=*/true);
+}
+
+YAML::Node search_config_cache_form(const YAML::Node& resolved) {
+  const auto search_keys = search_schema().keys();
+  const auto is_search_key = [&](const std::string& key) {
+    return std::find(search_keys.begin(), search_keys.end(), key) != search_keys.end();
+  };
+  // The search block as it was: the strategy's name, and evolution's options in `operators:`
+  // after `space:` (for every strategy: the random one ignored them).
+  YAML::Node search(YAML::NodeType::Map);
+  for (const auto& kv : resolved) {
+    const std::string key = kv.first.Scalar();
+    if (!is_search_key(key)) continue;
+    if (key == "strategy") {
+      search[key] = kv.second["type"];
+      continue;
+    }
+    search[key] = kv.second;
+    if (key != "space") continue;
+    YAML::Node operators = evolution_schema().emit(EvolutionOptions{});
+    if (resolved["strategy"]["type"].Scalar() == "evolution")
+      for (const auto& option : resolved["strategy"])
+        if (option.first.Scalar() != "type") operators[option.first.Scalar()] = option.second;
+    search["operators"] = operators;
+  }
+  YAML::Node out(YAML::NodeType::Map);
+  bool placed = false;
+  for (const auto& kv : resolved) {
+    const std::string key = kv.first.Scalar();
+    if (!is_search_key(key)) {
+      out[key] = kv.second;
+    } else if (!placed) {
+      out["search"] = search;  // the block sat where its first key sits now
+      placed = true;
+    }
+  }
+  return out;
 }
 
 namespace {

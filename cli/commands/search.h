@@ -14,7 +14,7 @@ namespace cgsr::cli {
 struct SearchCommandOptions : RunSettings {
   std::string parent;  // CG-enhanced model file (required)
   std::string data;    // data set directory (required)
-  SearchOptions search;
+  SearchOptions search;  // its keys sit at the top level of the config
   CandidateTraining candidate;
   TrainSchedule final_schedule;  // training of the pick (paper: 30 epochs)
   std::string name;              // display name of the result
@@ -22,6 +22,12 @@ struct SearchCommandOptions : RunSettings {
 };
 
 config::Schema<SearchCommandOptions> search_command_schema();
+
+// A resolved `cgsr search` config in the shape it had before the search options moved to the top
+// level and each strategy got its own options block (`search: {strategy: evolution, operators:
+// {...}}`): the search stage of `cgsr run` hashes this form, so run directories made before stay
+// current when nothing but the shape changed.
+YAML::Node search_config_cache_form(const YAML::Node& resolved);
 void setup_search(CLI::App& app);
 nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
                                           RunDir& run_dir);

@@ -11,23 +11,57 @@
 
 namespace cgsr::cli {
 
-config::Schema<TrainOptions> train_schema() {
-  config::Schema<EnhanceOptions> enhance;
-  enhance.field("enabled", &EnhanceOptions::enabled, "insert the RIT block (and geometry head) before training");
-  enhance.section("rit", &EnhanceOptions::rit, rit_spec_schema(), "rendering information transform block");
-  enhance.section("geometry", &EnhanceOptions::geometry, geometry_spec_schema(), "geometry head (training only)");
+namespace {
+config::Schema<EnhanceOptions> enhance_schema(bool with_enabled) {
+  config::Schema<EnhanceOptions> s;
+  if (with_enabled) s.field("enabled", &EnhanceOptions::enabled, "insert the RIT block (and geometry head) before training");
+  s.section("rit", &EnhanceOptions::rit, rit_spec_schema(), "rendering information transform block");
+  s.section("geometry", &EnhanceOptions::geometry, geometry_spec_schema(), "geometry head (training only)");
+  return s;
+}
 
+// The keys of a training config, with `add_enhancement` adding the CG enhancement's in their place.
+config::Schema<TrainOptions> train_schema_with(
+    const std::function<void(config::Schema<TrainOptions>&)>& add_enhancement) {
   config::Schema<TrainOptions> s;
   s.field("data", &TrainOptions::data, "data set directory (cgsr render output or a described capture)").required();
   s.field("model", &TrainOptions::model, "backbone name, spec file or model file to start from");
   s.field("scale", &TrainOptions::scale, "upscaling factor (must match a model file)").range(2, 4);
   s.field("name", &TrainOptions::name, "display name in reports");
-  s.section("enhance", &TrainOptions::enhance, enhance, "make a CG-enhanced network");
+  add_enhancement(s);
   s.section("schedule", &TrainOptions::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &TrainOptions::loss, loss_schema(), "CGSR loss weights");
   s.field("resume", &TrainOptions::resume, "continue from checkpoint.pt in the run directory");
   add_run_settings(s);
   return s;
+}
+
+// `enabled` of an enhance block moved up from `enhance: enhance:` (older cgsr run configs): the
+// stage always enhances, so it never meant anything there.
+YAML::Node drop_enabled(const YAML::Node& map, const config::Cursor& at) {
+  if (!map || !map.IsMap() || !map["enabled"]) return map;
+  const std::string where = at.doc ? at.doc->locate(map["enabled"]) : at.child("enabled").path;
+  config::warn_deprecated(where, "'" + at.child("enhance.enabled").path +
+                                     "' is ignored: the enhance stage always inserts the RIT block; remove it");
+  YAML::Node out(YAML::NodeType::Map);
+  for (const auto& kv : map)
+    if (!kv.first.IsScalar() || kv.first.Scalar() != "enabled") out.force_insert(kv.first, kv.second);
+  return out;
+}
+}  // namespace
+
+config::Schema<TrainOptions> train_schema() {
+  return train_schema_with([](config::Schema<TrainOptions>& s) {
+    s.section("enhance", &TrainOptions::enhance, enhance_schema(/*with_enabled=*/true), "make a CG-enhanced network");
+  });
+}
+
+config::Schema<TrainOptions> enhance_stage_schema() {
+  return train_schema_with([](config::Schema<TrainOptions>& s) {
+    s.inline_section(&TrainOptions::enhance, enhance_schema(/*with_enabled=*/false));
+    s.moved_block("enhance");  // older configs: `enhance: {enhance: {rit: ...}}`
+    s.upgrade(drop_enabled);
+  });
 }
 
 void setup_train(CLI::App& app) {

@@ -30,6 +30,10 @@ struct TrainOptions : RunSettings {
 };
 
 config::Schema<TrainOptions> train_schema();
+// The enhance stage of `cgsr run`: a training config whose enhance block's keys (rit, geometry)
+// sit at its top level, as the stage always enhances. It parses into TrainOptions, which emits
+// (and is recorded) as a `cgsr train` config.
+config::Schema<TrainOptions> enhance_stage_schema();
 void setup_train(CLI::App& app);
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 

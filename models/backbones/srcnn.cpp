@@ -18,7 +18,7 @@ BackboneInfo srcnn_info() {
   return info;
 }
 
-SrcnnImpl::SrcnnImpl(const ArchSpec& spec) : scale_(spec.scale), luma_(spec.colors == "y") {
+SrcnnImpl::SrcnnImpl(const ArchSpec& spec) : scale_(spec.scale), luma_(spec.colors == Colors::Y) {
   const int64_t c = spec.color_channels();
   conv1 = register_module("conv1", make_conv(c, spec.group_width("conv1"), 9));
   conv2 = register_module("conv2", make_conv(spec.group_width("conv1"), spec.group_width("conv2"), 5));

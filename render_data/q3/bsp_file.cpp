@@ -95,7 +95,18 @@ bool BspVisData::visible(int from, int to) const {
   return (bits[static_cast<size_t>(from) * bytes_per_cluster + (to >> 3)] >> (to & 7)) & 1;
 }
 
-BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
+namespace {
+// The file's lumps: the header checked (magic, version) and every lump inside the file and a
+// whole number of records.
+struct Lumps {
+  Span spans[kLumpCount];
+  std::string name;
+  Reader reader(Lump lump) const { return Reader(spans[static_cast<int>(lump)], name + ": " + lump_name(lump)); }
+};
+
+Lumps read_lump_directory(const uint8_t* data, size_t size, const std::string& name) {
+  Lumps lumps;
+  lumps.name = name;
   if (size < kHeaderBytes)
     throw Error(name + ": header", "file of " + std::to_string(size) + " bytes is shorter than the " +
                                        std::to_string(kHeaderBytes) + "-byte BSP header");
@@ -106,8 +117,7 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     throw Error(name + ": header", "version " + std::to_string(version) + " is not Quake III's " +
                                        std::to_string(kBspVersion));
 
-  // Lump directory: every lump inside the file and a whole number of records.
-  Span spans[kLumpCount];
+  // Lump directory.
   for (int i = 0; i < kLumpCount; ++i) {
     const Lump lump = static_cast<Lump>(i);
     const std::string context = name + ": " + lump_name(lump);
@@ -118,38 +128,38 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     if (kRecordBytes[i] && length % static_cast<int64_t>(kRecordBytes[i]) != 0)
       throw Error(context, "length " + std::to_string(length) + " is not a multiple of the " +
                                std::to_string(kRecordBytes[i]) + "-byte record");
-    spans[i] = {data + offset, static_cast<size_t>(length)};
+    lumps.spans[i] = {data + offset, static_cast<size_t>(length)};
   }
-  auto reader = [&](Lump lump) { return Reader(spans[static_cast<int>(lump)], name + ": " + lump_name(lump)); };
+  return lumps;
+}
 
-  BspFile bsp;
-  bsp.name = name;
-
+// The tables of plain records: entities, textures, planes, the tree, models, brushes, vertices, effects.
+void read_tables(const Lumps& lumps, BspFile& bsp) {
   {  // entities: text, NUL-terminated or not
-    const Span& s = spans[static_cast<int>(Lump::Entities)];
+    const Span& s = lumps.spans[static_cast<int>(Lump::Entities)];
     const char* text = reinterpret_cast<const char*>(s.data);
     bsp.entities.assign(text, strnlen(text, s.size));
   }
   {
-    const Reader r = reader(Lump::Textures);
+    const Reader r = lumps.reader(Lump::Textures);
     for (size_t i = 0; i < r.count(Lump::Textures); ++i) {
       const size_t o = i * 72;
       bsp.textures.push_back({r.name(o, 64), r.i32(o + 64), r.i32(o + 68)});
     }
   }
   {
-    const Reader r = reader(Lump::Planes);
+    const Reader r = lumps.reader(Lump::Planes);
     for (size_t i = 0; i < r.count(Lump::Planes); ++i) bsp.planes.push_back({r.vec3(i * 16, i), r.f32(i * 16 + 12, i)});
   }
   {
-    const Reader r = reader(Lump::Nodes);
+    const Reader r = lumps.reader(Lump::Nodes);
     for (size_t i = 0; i < r.count(Lump::Nodes); ++i) {
       const size_t o = i * 36;
       bsp.nodes.push_back({r.i32(o), {r.i32(o + 4), r.i32(o + 8)}, r.ivec3(o + 12), r.ivec3(o + 24)});
     }
   }
   {
-    const Reader r = reader(Lump::Leafs);
+    const Reader r = lumps.reader(Lump::Leafs);
     for (size_t i = 0; i < r.count(Lump::Leafs); ++i) {
       const size_t o = i * 48;
       bsp.leafs.push_back({r.i32(o), r.i32(o + 4), r.ivec3(o + 8), r.ivec3(o + 20), r.i32(o + 32), r.i32(o + 36),
@@ -157,28 +167,28 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     }
   }
   for (Lump lump : {Lump::LeafFaces, Lump::LeafBrushes, Lump::MeshVerts}) {
-    const Reader r = reader(lump);
+    const Reader r = lumps.reader(lump);
     auto& out = lump == Lump::LeafFaces ? bsp.leaf_faces : lump == Lump::LeafBrushes ? bsp.leaf_brushes : bsp.mesh_verts;
     for (size_t i = 0; i < r.count(lump); ++i) out.push_back(r.i32(i * 4));
   }
   {
-    const Reader r = reader(Lump::Models);
+    const Reader r = lumps.reader(Lump::Models);
     for (size_t i = 0; i < r.count(Lump::Models); ++i) {
       const size_t o = i * 40;
       bsp.models.push_back({r.vec3(o, i), r.vec3(o + 12, i), r.i32(o + 24), r.i32(o + 28), r.i32(o + 32), r.i32(o + 36)});
     }
   }
   {
-    const Reader r = reader(Lump::Brushes);
+    const Reader r = lumps.reader(Lump::Brushes);
     for (size_t i = 0; i < r.count(Lump::Brushes); ++i)
       bsp.brushes.push_back({r.i32(i * 12), r.i32(i * 12 + 4), r.i32(i * 12 + 8)});
   }
   {
-    const Reader r = reader(Lump::BrushSides);
+    const Reader r = lumps.reader(Lump::BrushSides);
     for (size_t i = 0; i < r.count(Lump::BrushSides); ++i) bsp.brush_sides.push_back({r.i32(i * 8), r.i32(i * 8 + 4)});
   }
   {
-    const Reader r = reader(Lump::Vertices);
+    const Reader r = lumps.reader(Lump::Vertices);
     bsp.vertices.reserve(r.count(Lump::Vertices));
     for (size_t i = 0; i < r.count(Lump::Vertices); ++i) {
       const size_t o = i * 44;
@@ -193,12 +203,16 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     }
   }
   {
-    const Reader r = reader(Lump::Effects);
+    const Reader r = lumps.reader(Lump::Effects);
     for (size_t i = 0; i < r.count(Lump::Effects); ++i)
       bsp.effects.push_back({r.name(i * 72, 64), r.i32(i * 72 + 64), r.i32(i * 72 + 68)});
   }
+}
+
+// The faces, with their surface type checked.
+void read_faces(const Lumps& lumps, BspFile& bsp) {
   {
-    const Reader r = reader(Lump::Faces);
+    const Reader r = lumps.reader(Lump::Faces);
     bsp.faces.reserve(r.count(Lump::Faces));
     for (size_t i = 0; i < r.count(Lump::Faces); ++i) {
       const size_t o = i * 104;
@@ -222,15 +236,19 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
       bsp.faces.push_back(f);
     }
   }
+}
+
+// Lightmaps, the light volume grid and the visibility data (its header checked against the lump).
+void read_lighting_and_vis(const Lumps& lumps, BspFile& bsp) {
   {
-    const Reader r = reader(Lump::Lightmaps);
+    const Reader r = lumps.reader(Lump::Lightmaps);
     for (size_t i = 0; i < r.count(Lump::Lightmaps); ++i) {
       const uint8_t* p = r.span().data + i * kRecordBytes[static_cast<int>(Lump::Lightmaps)];
       bsp.lightmaps.push_back({std::vector<uint8_t>(p, p + kRecordBytes[static_cast<int>(Lump::Lightmaps)])});
     }
   }
   {
-    const Reader r = reader(Lump::LightVols);
+    const Reader r = lumps.reader(Lump::LightVols);
     for (size_t i = 0; i < r.count(Lump::LightVols); ++i) {
       const size_t o = i * 8;
       bsp.light_volumes.push_back(
@@ -238,7 +256,7 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     }
   }
   {
-    const Reader r = reader(Lump::VisData);
+    const Reader r = lumps.reader(Lump::VisData);
     const Span& s = r.span();
     if (s.size > 0) {
       if (s.size < 8) throw Error(r.context(), "lump of " + std::to_string(s.size) + " bytes has no 8-byte header");
@@ -252,13 +270,13 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
       bsp.vis.bits.assign(s.data + 8, s.data + 8 + clusters * bytes);
     }
   }
+}
 
-  // ---- cross-references: every index lands inside its table ----
-  const int64_t n_textures = bsp.textures.size(), n_planes = bsp.planes.size(), n_nodes = bsp.nodes.size(),
-                n_leafs = bsp.leafs.size(), n_faces = bsp.faces.size(), n_brushes = bsp.brushes.size(),
-                n_effects = bsp.effects.size(), n_lightmaps = bsp.lightmaps.size();
+// The nodes: indices inside their tables, and a tree below node 0 of bounded depth.
+void check_node_tree(const Lumps& lumps, BspFile& bsp) {
+  const int64_t n_planes = bsp.planes.size(), n_nodes = bsp.nodes.size(), n_leafs = bsp.leafs.size();
   {
-    const Reader r = reader(Lump::Nodes);
+    const Reader r = lumps.reader(Lump::Nodes);
     if (n_nodes == 0) throw Error(r.context(), "lump is empty: a map needs at least one node");
     for (size_t i = 0; i < bsp.nodes.size(); ++i) {
       const BspNode& n = bsp.nodes[i];
@@ -287,8 +305,14 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
       }
     }
   }
+}
+
+// Every other record's indices land inside their tables.
+void check_table_references(const Lumps& lumps, const BspFile& bsp) {
+  const int64_t n_textures = bsp.textures.size(), n_planes = bsp.planes.size(), n_faces = bsp.faces.size(),
+                n_brushes = bsp.brushes.size();
   {
-    const Reader r = reader(Lump::Leafs);
+    const Reader r = lumps.reader(Lump::Leafs);
     for (size_t i = 0; i < bsp.leafs.size(); ++i) {
       const BspLeaf& l = bsp.leafs[i];
       check_range(r, i, "leaf faces", l.first_leaf_face, l.leaf_face_count, bsp.leaf_faces.size());
@@ -297,15 +321,15 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     }
   }
   {
-    const Reader r = reader(Lump::LeafFaces);
+    const Reader r = lumps.reader(Lump::LeafFaces);
     for (size_t i = 0; i < bsp.leaf_faces.size(); ++i) check_index(r, i, "face", bsp.leaf_faces[i], 0, n_faces);
   }
   {
-    const Reader r = reader(Lump::LeafBrushes);
+    const Reader r = lumps.reader(Lump::LeafBrushes);
     for (size_t i = 0; i < bsp.leaf_brushes.size(); ++i) check_index(r, i, "brush", bsp.leaf_brushes[i], 0, n_brushes);
   }
   {
-    const Reader r = reader(Lump::Models);
+    const Reader r = lumps.reader(Lump::Models);
     if (bsp.models.empty()) throw Error(r.context(), "lump is empty: the world model is missing");
     for (size_t i = 0; i < bsp.models.size(); ++i) {
       check_range(r, i, "faces", bsp.models[i].first_face, bsp.models[i].face_count, bsp.faces.size());
@@ -313,27 +337,32 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
     }
   }
   {
-    const Reader r = reader(Lump::Brushes);
+    const Reader r = lumps.reader(Lump::Brushes);
     for (size_t i = 0; i < bsp.brushes.size(); ++i) {
       check_range(r, i, "sides", bsp.brushes[i].first_side, bsp.brushes[i].side_count, bsp.brush_sides.size());
       check_index(r, i, "texture", bsp.brushes[i].texture, 0, n_textures);
     }
   }
   {
-    const Reader r = reader(Lump::BrushSides);
+    const Reader r = lumps.reader(Lump::BrushSides);
     for (size_t i = 0; i < bsp.brush_sides.size(); ++i) {
       check_index(r, i, "plane", bsp.brush_sides[i].plane, 0, n_planes);
       check_index(r, i, "texture", bsp.brush_sides[i].texture, 0, n_textures);
     }
   }
   {
-    const Reader r = reader(Lump::Effects);
+    const Reader r = lumps.reader(Lump::Effects);
     for (size_t i = 0; i < bsp.effects.size(); ++i) {
       check_index(r, i, "brush", bsp.effects[i].brush, -1, n_brushes);
     }
   }
+}
+
+// Each face's indices, and its mesh or patch consistent with its type.
+void check_face_references(const Lumps& lumps, const BspFile& bsp) {
+  const int64_t n_textures = bsp.textures.size(), n_effects = bsp.effects.size(), n_lightmaps = bsp.lightmaps.size();
   {
-    const Reader r = reader(Lump::Faces);
+    const Reader r = lumps.reader(Lump::Faces);
     for (size_t i = 0; i < bsp.faces.size(); ++i) {
       const BspFace& f = bsp.faces[i];
       check_index(r, i, "texture", f.texture, 0, n_textures);
@@ -364,6 +393,20 @@ BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
       }
     }
   }
+}
+}  // namespace
+
+BspFile parse_bsp(const uint8_t* data, size_t size, const std::string& name) {
+  const Lumps lumps = read_lump_directory(data, size, name);
+  BspFile bsp;
+  bsp.name = name;
+  read_tables(lumps, bsp);
+  read_faces(lumps, bsp);
+  read_lighting_and_vis(lumps, bsp);
+  // Cross-references: every index lands inside its table.
+  check_node_tree(lumps, bsp);
+  check_table_references(lumps, bsp);
+  check_face_references(lumps, bsp);
   return bsp;
 }
 

@@ -81,3 +81,13 @@ TEST(Cli, PrintConfigShowsResolvedDefaults) {
   EXPECT_NE(r.out.find("json: true"), std::string::npos);
   EXPECT_NE(r.out.find("threads: 0"), std::string::npos);
 }
+
+TEST(Cli, AListAsAKeyInAStageSectionIsAUserErrorAtItsLine) {
+  const auto dir = scratch_dir("cli-run-key");
+  const auto file = dir / "run.yaml";
+  cgsr::write_file_atomic(file, "name: x\ndata: " + dir.string() + "\ntrain:\n  ? [a, b]\n  : 1\n");
+  const auto r = run_cgsr("run --config " + file.string() + " --out " + (dir / "run").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(file.string() + ":4:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a key must be a name"), std::string::npos) << r.err;
+}

@@ -246,7 +246,7 @@ TEST(OnnxWriter, WhatTheWriterCannotExpressIsAClearError) {
   nan.ops[1].weight = nan.ops[1].weight.clone();
   nan.ops[1].weight.view(-1)[0] = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(onnx_model_bytes(nan, fixed(6, 5)), Error);
-  EXPECT_THROW(cubic_resize_from_name("cubic"), Error);
+  EXPECT_THROW(enum_from_name<CubicResize>("cubic"), Error);
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ inline std::vector<BackboneCase> all_backbone_cases() {
 
 inline ArchSpec spec_for(const BackboneCase& c) {
   ArchSpec s = default_spec(c.backbone, c.scale);
-  s.colors = c.colors;
+  s.colors = enum_from_name<Colors>(c.colors);
   return resolve_spec(s);
 }
 
@@ -39,8 +39,8 @@ inline std::string case_name(const BackboneCase& c) {
 inline ArchSpec with_rit(ArchSpec s, const std::string& source = "lr", const std::string& fusion = "concat",
                          bool geometry = false) {
   s.rit.enabled = true;
-  s.rit.source = source;
-  s.rit.fusion = fusion;
+  s.rit.source = enum_from_name<RitSource>(source);
+  s.rit.fusion = enum_from_name<RitFusion>(fusion);
   s.geometry.enabled = geometry;
   return resolve_spec(s);
 }

@@ -34,7 +34,7 @@ TEST(Complexity, EdsrBaselineMatchesPublishedMacs) {
 
 TEST(Complexity, SrcnnLumaMatchesPublishedMacs) {
   ArchSpec s = default_spec("srcnn", 2);
-  s.colors = "y";
+  s.colors = Colors::Y;
   EXPECT_EQ(macs_at_720p(s, 1), 527);  // 52.7G
 }
 

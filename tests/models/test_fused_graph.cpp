@@ -129,7 +129,7 @@ TEST_F(FusedGraphTest, EveryBackboneAtEveryScale) {
       SCOPED_TRACE(name + " x" + std::to_string(scale));
       expect_network_matches(spec, ++seed);
       if (backbone_registry().get(name).supports_y) {
-        spec.colors = "y";
+        spec.colors = Colors::Y;
         SCOPED_TRACE("luma");
         expect_network_matches(resolve_spec(spec), ++seed);
       }

@@ -155,7 +155,7 @@ TEST(Inherit, ImpossibleChildrenAreErrors) {
   EXPECT_THROW(inherit(*parent, default_spec("edsr", 2)), Error);
   SRNetwork cg(with_rit(default_spec("pan", 2), "lr", "concat"));
   ArchSpec other = cg->spec();
-  other.rit.fusion = "add";
+  other.rit.fusion = RitFusion::Add;
   try {
     inherit(*cg, other);
     FAIL();

@@ -193,12 +193,11 @@ TEST(KillResume, SearchResumedTwiceMakesTheUninterruptedPick) {
   const auto parent = train_cg_parent(dir, data);
   // 1 parent + 2 generations of 3 candidates: 7 history lines; every candidate trains 60 steps.
   const auto config = dir / "search.yaml";
-  std::ofstream(config) << R"(search:
-  population: 3
-  selection_ratio: 0.34
-  generations: 2
-  min_candidates: 1
-  tolerance_db: 0.5
+  std::ofstream(config) << R"(population: 3
+selection_ratio: 0.34
+generations: 2
+min_candidates: 1
+tolerance_db: 0.5
 candidate:
   schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, layout: nhwc}
 final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5, layout: nhwc}

@@ -25,12 +25,16 @@ train:
   schedule: {steps: 6, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, checkpoint_every: 3}
 enhance:
   name: CG-enhanced PAN x2
-  enhance: {rit: {channels: [depth, normal_angle, edge], width: 8, hr_width: 8, source: hr_unshuffle+hr_fuse},
-            geometry: {enabled: true, width: 8}}
+  rit: {channels: [depth, normal_angle, edge], width: 8, hr_width: 8, source: hr_unshuffle+hr_fuse}
+  geometry: {enabled: true, width: 8}
   schedule: {steps: 4, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 search:
   name: CG-optimized PAN x2
-  search: {population: 2, selection_ratio: 0.5, generations: 1, min_candidates: 1, tolerance_db: 100}
+  population: 2
+  selection_ratio: 0.5
+  generations: 1
+  min_candidates: 1
+  tolerance_db: 100
   candidate:
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
   final: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}

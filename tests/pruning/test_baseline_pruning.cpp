@@ -62,7 +62,7 @@ TEST(ImportanceMethods, OneRegistryScoresEveryUnitGroup) {
   const auto reference = channel_importance(net->describe(false));
   for (const auto& name : importance_methods().names()) {
     SCOPED_TRACE(name);
-    const FrameImportance scores = importance_methods().get(name)(*net, b, units);
+    const FrameImportance scores = importance_methods().get(name).score(*net, b, units);
     for (const auto& u : units)
       for (size_t g = 0; g < u.groups.size(); ++g) {
         ASSERT_TRUE(scores.count(u.groups[g]));

@@ -35,7 +35,7 @@ TEST(DynamicPruning, NarrowerPatternsLearnTheWidestOutputWhenDistilling) {
   // Without distillation it learns the HR frame.
   options.distill = false;
   const double to_hr = dynamic.hooks(options).extra_loss(batch, narrow_output, 0).item<double>();
-  EXPECT_NEAR(to_hr, reconstruction_error(narrow_output.image, batch.hr_color, "l2").item<double>(), 1e-6);
+  EXPECT_NEAR(to_hr, reconstruction_error(narrow_output.image, batch.hr_color, ErrorNorm::L2).item<double>(), 1e-6);
   EXPECT_GT(to_hr, 1e-6);
   // Eq. 4's L1 term on the weights the pattern leaves out, when asked for.
   options.lambda_pruned = 1e-3;

@@ -220,9 +220,49 @@ TEST(SearchLoop, AResumedSearchReachesTheSamePick) {
 TEST(SearchLoop, RandomStrategyRunsThroughTheSameLoop) {
   seed_everything(2);
   auto options = small_search();
-  options.strategy = "random";
+  options.strategy.type = "random";
   ScoringEvaluator evaluator(enhanced_pan());
   SearchHistory history(history_path("random"), false);
   const auto result = run_search(enhanced_pan(), evaluator, history, options);
   EXPECT_EQ(static_cast<int>(result.evaluated.size()), options.population * options.generations);
+}
+
+namespace {
+SearchOptions parse_search(const std::string& yaml) {
+  return config::parse_document(config::Document::parse(yaml, "search.yaml"), search_schema());
+}
+std::string search_error(const std::string& yaml) {
+  try {
+    parse_search(yaml);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+}  // namespace
+
+TEST(SearchOptions, EachStrategyHasItsOwnOptionsBlockAndABareNameKeepsItsDefaults) {
+  const auto block = parse_search("strategy: {type: evolution, mutation_rate: 0.3}\n");
+  EXPECT_EQ(block.strategy.type, "evolution");
+  EXPECT_DOUBLE_EQ(block.strategy.evolution.mutation_rate, 0.3);
+  EXPECT_DOUBLE_EQ(block.strategy.evolution.crossover_rate, EvolutionOptions{}.crossover_rate);
+  EXPECT_EQ(parse_search("strategy: random\n").strategy.type, "random");
+  // Written back as the block, which reads back the same.
+  const std::string emitted = config::to_yaml(search_schema().emit(block));
+  EXPECT_NE(emitted.find("type: evolution"), std::string::npos) << emitted;
+  EXPECT_DOUBLE_EQ(parse_search(emitted).strategy.evolution.mutation_rate, 0.3);
+
+  EXPECT_NE(search_error("strategy: evolutoin\n").find("did you mean 'evolution'"), std::string::npos);
+  EXPECT_NE(search_error("strategy: {mutation_rate: 0.3}\n").find("missing required key 'type'"), std::string::npos);
+  EXPECT_NE(search_error("strategy: {type: random, mutation_rate: 0.3}\n").find("search.yaml:1:25"), std::string::npos);
+  EXPECT_NE(search_error("strategy: {type: evolution, mutation_rate: 2}\n").find("strategy.mutation_rate"),
+            std::string::npos);
+}
+
+TEST(SearchOptions, TheFormerSharedOperatorsBlockMovesIntoTheEvolutionBlock) {
+  const auto old = parse_search("strategy: evolution\noperators: {mutation_rate: 0.25}\n");
+  EXPECT_EQ(old.strategy.type, "evolution");
+  EXPECT_DOUBLE_EQ(old.strategy.evolution.mutation_rate, 0.25);
+  // The random strategy never read them.
+  EXPECT_EQ(parse_search("strategy: random\noperators: {mutation_rate: 0.25}\n").strategy.type, "random");
 }
