@@ -3,8 +3,10 @@
 // implements this with the trainer (warm start, a few epochs, validation); the search itself
 // never sees training, so candidates could as well be evaluated on other machines.
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <vector>
 
 #include "models/arch_spec.h"
 
@@ -30,6 +32,11 @@ class Evaluator {
   // The parent itself, given exactly a candidate's treatment (same training, same validation),
   // so the pick rule compares like with like.
   virtual CandidateScore evaluate_parent() = 0;
+  // A generation's new candidates: reports each score as done(index, score), in index order
+  // (the order the history records). By default one after another in this process; a
+  // distributed evaluator spreads them over processes (cli/distributed_search.h).
+  virtual void evaluate_batch(const std::vector<ArchSpec>& specs,
+                              const std::function<void(size_t index, const CandidateScore& score)>& done);
 };
 
 }  // namespace cgsr

@@ -14,6 +14,7 @@
 #include "cli/commands/render.h"
 #include "cli/commands/report.h"
 #include "cli/commands/search.h"
+#include "cli/distributed_run.h"
 #include "cli/commands/train.h"
 #include "cli/stage_cache.h"
 #include "core/atomic_file.h"
@@ -134,7 +135,7 @@ class StageRunner {
     ++index_;
     forcing_ = forcing_ || stage == from_;
     StageOutcome outcome;
-    outcome.hash = stage_hash(resolved, upstream);
+    outcome.hash = stage_hash(without_distribution(resolved), upstream);
     const fs::path where = dir(stage);
     if (!forcing_ && stage_is_current(where, outcome.hash)) {
       spdlog::info("[{}/{}] {}: up to date in {}, skipped", index_, total_, stage, where.string());
