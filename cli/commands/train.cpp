@@ -91,6 +91,7 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
     TrainOptions job = options;
     job.data.clear();
     job.distributed = {};
+    job.threads = 0;  // compared separately (a warning)
     if (source.kind == ModelSource::Kind::ModelFile) job.model = std::to_string(fnv1a64(read_file(options.model)));
     world = join_run(options.distributed, config::to_yaml(train_schema().emit(job)) + "\n" +
                                               std::to_string(data.frames(Split::Train).size()) + " " +
