@@ -10,17 +10,21 @@
 # `cgsr run --config configs/quickstart.yaml`.
 #
 #   bash bench/distributed_search.sh [--out runs/distributed-search] [--build build] [--generations 2]
+#                                    [--candidate-steps 60]   (training steps of each candidate)
 set -euo pipefail
 
 out=runs/distributed-search
 build=build
 generations=2
+candidate_steps=60
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
     --generations) generations="$2"; shift 2 ;;
-    *) echo "usage: bench/distributed_search.sh [--out DIR] [--build DIR] [--generations N]" >&2; exit 2 ;;
+    --candidate-steps) candidate_steps="$2"; shift 2 ;;
+    *) echo "usage: bench/distributed_search.sh [--out DIR] [--build DIR] [--generations N] [--candidate-steps N]" >&2
+       exit 2 ;;
   esac
 done
 cgsr="$build/cgsr"
@@ -28,7 +32,7 @@ cgsr="$build/cgsr"
 rm -rf "$out"
 mkdir -p "$out"
 args=(search --config configs/search/compare.yaml --seed 1 --set "search.generations=$generations"
-      --set candidate.schedule.layout=nhwc --set final.steps=2 --set final.layout=nhwc)
+      --set "candidate.schedule.steps=$candidate_steps" --set candidate.schedule.layout=nhwc --set final.steps=2 --set final.layout=nhwc)
 port=$((20000 + $$ % 20000))
 
 run() {  # name, then the command; prints "name seconds load"
