@@ -1,9 +1,10 @@
 // `cgsr search` and `cgsr train` as two local processes (--world-size 2) against one process with
 // the same seed and threads: the search records the same history and makes the same pick, also
-// when one rank is SIGKILLed mid-candidate; data-parallel training follows the 1-process loss
-// curve. Every process runs one thread, so the two ranks share this 2-core machine fairly.
+// when rank 1 is SIGKILLed mid-candidate (the survivor trains its candidate) or rank 0 is (all
+// resume); data-parallel training follows the 1-process loss curve, also killed and resumed. Every process runs one thread, so the two ranks share this 2-core machine fairly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -124,6 +125,38 @@ TEST_F(DistributedSearch, ARankKilledMidCandidateLosesNothing) {
   }
   ASSERT_EQ(rank0.wait(), 0) << rank0.err();
   EXPECT_NE(rank0.err().find("goes back to the queue"), std::string::npos) << rank0.err();
+  expect_same_search(dir_ / "reference", out);
+}
+
+// Rank 0 holds the store: when it dies the others stop, and all are restarted with --resume.
+TEST_F(DistributedSearch, RankZeroKilledMidSearchResumesToTheSamePick) {
+  const auto out = dir_ / "resumed";
+  auto args = [&](int rank, int port, bool resume) {
+    auto a = as_rank(with_run_flags(search_args(), out), rank, port);
+    a.insert(a.end(), {"--set", "distributed.timeout=20"});
+    if (resume) a.push_back("--resume");
+    return a;
+  };
+  const auto recorded = [&] {  // whole lines only: the last may be half written
+    const std::string text = slurp(out / "history.jsonl");
+    return std::count(text.begin(), text.end(), '\n');
+  };
+  {
+    const int port = free_port();
+    CgsrProcess rank1(args(1, port, false), dir_ / "resumed-rank1-first");
+    CgsrProcess rank0(args(0, port, false), dir_ / "resumed-rank0-first");
+    // Killed once the parent and a first candidate are recorded.
+    ASSERT_TRUE(rank0.wait_for([&] { return recorded() >= 2; }, 60s)) << rank0.err();
+    ASSERT_TRUE(rank0.kill()) << "rank 0 finished before it could be killed";
+    EXPECT_NE(rank1.wait(), 0);
+    EXPECT_NE(rank1.err().find("lost the store"), std::string::npos) << rank1.err();
+  }
+  EXPECT_LT(recorded(), 9);
+  const int port = free_port();
+  CgsrProcess rank1(args(1, port, true), dir_ / "resumed-rank1");
+  const auto r = run_cgsr_args(args(0, port, true), dir_ / "resumed-rank0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(rank1.wait(), 0) << rank1.err();
   expect_same_search(dir_ / "reference", out);
 }
 
