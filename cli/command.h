@@ -60,13 +60,15 @@ void begin_command(const RunSettings& run);
 // `flags` registers the command's own CLI flags; each flag appends assignments to the vector.
 // The run directory exists when --out is given, or always when `always_run_dir` is true
 // (default runs/<name>-<time>). `body` gets the options, the resolved config and the run
-// directory, and returns the results written to results.json.
+// directory, and returns the results written to results.json. `place_run_dir`, when given, moves
+// the run directory (e.g. a distributed rank's own subdirectory).
 template <class T>
 CLI::App* add_command(CLI::App& app, const std::string& name, const std::string& description,
                       std::function<config::Schema<T>()> schema,
                       std::function<void(CLI::App&, std::vector<FlagAssignment>&)> flags,
                       std::function<nlohmann::ordered_json(const T&, const YAML::Node&, RunDir*)> body,
-                      bool always_run_dir) {
+                      bool always_run_dir,
+                      std::function<std::filesystem::path(const T&, const std::filesystem::path&)> place_run_dir = {}) {
   CLI::App* sub = app.add_subcommand(name, description);
   auto assignments = std::make_shared<std::vector<FlagAssignment>>();
   if (flags) flags(*sub, *assignments);
@@ -81,9 +83,11 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
     }
     begin_command(options);
     std::unique_ptr<RunDir> run_dir;
-    if (!globals().out.empty() || always_run_dir)
-      run_dir = std::make_unique<RunDir>(globals().out.empty() ? default_run_dir(name)
-                                                                  : std::filesystem::path(globals().out));
+    if (!globals().out.empty() || always_run_dir) {
+      std::filesystem::path dir = globals().out.empty() ? default_run_dir(name) : std::filesystem::path(globals().out);
+      if (place_run_dir) dir = place_run_dir(options, dir);
+      run_dir = std::make_unique<RunDir>(dir);
+    }
     if (run_dir) run_dir->write_config(resolved);
     const nlohmann::ordered_json results = body(options, resolved, run_dir.get());
     if (run_dir) run_dir->write_results(results);

@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libtorch-dev          # LibTorch 1.13 (CPU)
+  libgloo-dev           # Gloo headers for LibTorch's c10d::ProcessGroupGloo (distributed/; the code is in libtorch)
   libopenblas0-openmp   # BLAS for LibTorch: without it libblas.so.3 is the reference BLAS, and every
                         # GEMM-based kernel (NCHW conv backward among them) runs ~10x slower
   libdnnl-dev           # oneDNN headers and CMake package (the fused inference path)

@@ -15,6 +15,11 @@ nlohmann::ordered_json to_json(const CandidateScore& s) {
   return j;
 }
 
+void Evaluator::evaluate_batch(const std::vector<ArchSpec>& specs,
+                               const std::function<void(size_t, const CandidateScore&)>& done) {
+  for (size_t i = 0; i < specs.size(); ++i) done(i, evaluate(specs[i]));
+}
+
 CandidateScore candidate_score_from_json(const nlohmann::json& j) {
   CandidateScore s;
   s.val_psnr = j.at("val_psnr");

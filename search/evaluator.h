@@ -3,6 +3,7 @@
 // implements this with the trainer (warm start, a few epochs, validation); the search itself
 // never sees training, so candidates could as well be evaluated on other machines.
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <vector>
@@ -34,6 +35,11 @@ class Evaluator {
   // The parent's blocks, least important first (models/block_importance.h): the order in which
   // shallower candidates drop them. Empty: the last block first.
   virtual std::vector<int> block_drop_order() const { return {}; }
+  // A generation's new candidates: reports each score as done(index, score), in index order
+  // (the order the history records). By default one after another in this process; a
+  // distributed evaluator spreads them over processes (cli/distributed_search.h).
+  virtual void evaluate_batch(const std::vector<ArchSpec>& specs,
+                              const std::function<void(size_t index, const CandidateScore& score)>& done);
 };
 
 }  // namespace cgsr

@@ -126,24 +126,37 @@ SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, Searc
       break;
     }
     Progress progress("search generation " + std::to_string(generation), static_cast<int64_t>(proposals.size()));
-    std::vector<Candidate> generation_candidates;
-    for (const auto& spec : proposals) {
-      Candidate c;
-      c.spec = spec;
-      c.key = SearchSpace::key(spec);
+    std::vector<Candidate> generation_candidates(proposals.size());
+    std::vector<ArchSpec> to_evaluate;
+    std::vector<size_t> slots;  // generation_candidates index of each spec in to_evaluate
+    const auto report = [&](const Candidate& c) {
+      progress.set_status(spec_summary(c.spec) + " " + std::to_string(c.score.val_psnr).substr(0, 6) + " dB");
+      progress.advance();
+    };
+    for (size_t i = 0; i < proposals.size(); ++i) {
+      Candidate& c = generation_candidates[i];
+      c.spec = proposals[i];
+      c.key = SearchSpace::key(c.spec);
       c.generation = generation;
       if (const auto* e = history.find(c.key)) {
         c.score = e->score;  // evaluated before an interruption
+        report(c);
       } else {
-        c.score = evaluator.evaluate(spec);
-        history.append({generation, spec, c.key, c.score});
+        to_evaluate.push_back(c.spec);
+        slots.push_back(i);
       }
+    }
+    // In proposal order, so the history reads the same however the evaluator spreads the work.
+    evaluator.evaluate_batch(to_evaluate, [&](size_t k, const CandidateScore& score) {
+      Candidate& c = generation_candidates[slots[k]];
+      c.score = score;
+      history.append({generation, c.spec, c.key, c.score});
+      report(c);
+    });
+    for (auto& c : generation_candidates) {
       c.fitness = fitness(c.score, result.parent.score, options.fitness);
       evaluated_keys.insert(c.key);
-      generation_candidates.push_back(c);
       result.evaluated.push_back(c);
-      progress.set_status(spec_summary(spec) + " " + std::to_string(c.score.val_psnr).substr(0, 6) + " dB");
-      progress.advance();
     }
     progress.finish();
 

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "core/atomic_file.h"
+#include "core/enum_names.h"
+#include "distributed/world.h"
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/progress.h"
@@ -78,6 +80,33 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
 }
 
 namespace {
+// This rank's equal share of a global batch (data-parallel training).
+Batch rank_slice(const Batch& batch, const distributed::World& world) {
+  const int64_t n = batch.lr_color.size(0), per = n / world.size(), begin = world.rank() * per, end = begin + per;
+  const auto cut = [&](const torch::Tensor& t) {
+    return t.defined() && t.dim() > 0 && t.size(0) == n ? t.slice(0, begin, end) : t;
+  };
+  Batch share = batch;
+  share.lr_color = cut(batch.lr_color);
+  share.lr_info = cut(batch.lr_info);
+  share.hr_color = cut(batch.hr_color);
+  share.hr_info = cut(batch.hr_info);
+  if (static_cast<int64_t>(batch.frames.size()) == n)
+    share.frames.assign(batch.frames.begin() + begin, batch.frames.begin() + end);
+  return share;
+}
+
+// Rank 0's checkpoint (or its absence) becomes every rank's, so all resume from the same step.
+void share_checkpoint(distributed::World& world, const std::filesystem::path& path, bool resume) {
+  const bool have = world.coordinator() && resume && std::filesystem::exists(path);
+  const std::string payload = world.broadcast("checkpoint", have ? "1" + read_file(path) : std::string("0"));
+  if (world.coordinator()) return;
+  if (payload[0] == '1')
+    write_file_atomic(path, payload.substr(1));
+  else
+    std::filesystem::remove(path);
+}
+
 // The trainable parameters: the backbone's, then the rendering-information parts' (RIT, HR
 // branch, geometry head), which may learn at another rate.
 struct TrainableParameters {
@@ -228,7 +257,9 @@ void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const
   archive.write("best", best);
   archive.write("step", torch::tensor(static_cast<int64_t>(step)));
   archive.write("spec", text_tensor(spec_to_yaml(network_->spec())));
-  archive.write("outcome", text_tensor(to_json(outcome).dump()));
+  nlohmann::ordered_json state = to_json(outcome);
+  state["loss_curve"] = outcome.loss_curve;
+  archive.write("outcome", text_tensor(state.dump()));
   archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
   archive.write("layout", text_tensor(enum_name(layout_)));
   write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
@@ -283,6 +314,8 @@ bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, Trai
     outcome.best = score(j["best"]);
     outcome.last = score(j["last"]);
     for (const auto& s : j["history"]) outcome.history.push_back(score(s));
+    if (j.contains("loss_curve"))
+      for (const auto& v : j["loss_curve"]) outcome.loss_curve.push_back(v.is_null() ? NAN : v.get<double>());
     torch::Tensor layout;
     if (archive.try_read("layout", layout)) layout_ = enum_from_name<MemoryLayout>(tensor_text(layout));
     archive.read("torch_rng", rng);
@@ -321,6 +354,13 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   int step = 0;
   NchwOnExit nchw_on_exit{*network_};
   layout_ = MemoryLayout::Auto;
+  if (world_) {
+    if (schedule_.batch_size % world_->size() != 0)
+      throw Error("schedule.batch_size", "a batch of " + std::to_string(schedule_.batch_size) +
+                                             " does not split evenly over " + std::to_string(world_->size()) +
+                                             " data-parallel ranks");
+    if (checkpoint) share_checkpoint(*world_, *checkpoint, resume);
+  }
   if (checkpoint && resume && load_checkpoint(*checkpoint, step, outcome)) {
     outcome.resumed = true;
     spdlog::info("resuming from {} at step {}/{}", checkpoint->string(), step, schedule_.steps);
@@ -337,8 +377,10 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.prefetch = schedule_.prefetch;
   PatchSampler sampler(data_, sampling);
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).
-  if (layout_ == MemoryLayout::Auto) layout_ = choose_layout(sampler.build(step));
+  if (layout_ == MemoryLayout::Auto && (!world_ || world_->coordinator())) layout_ = choose_layout(sampler.build(step));
+  if (world_) layout_ = enum_from_name<MemoryLayout>(world_->broadcast("layout", enum_name(layout_)));
   set_parameter_layout(*network_, layout_);
+  if (world_) world_->broadcast_tensors(tracked());  // every rank starts from rank 0's weights
   outcome.layout = enum_name(layout_);
 
   network_->train();
@@ -363,16 +405,33 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
 
     // Batches are a function of the step, so a resumed run sees the same data.
     lap_start = Clock::now();
-    const Batch batch = in_layout(sampler.batch(step), layout_);
+    const Batch batch = in_layout(world_ ? rank_slice(sampler.batch(step), *world_) : sampler.batch(step), layout_);
     lap(spent.batch);
     const auto output = forward(batch, step);
     LossTerms terms = cgsr_loss(*network_, output, batch, loss_, shrink_);
     if (hooks_.extra_loss) terms.total = terms.total + hooks_.extra_loss(batch, output, step);
     optimizer_->zero_grad();
-    bool finite = std::isfinite(terms.total.item<double>());
+    double loss = terms.total.item<double>(), image_loss = terms.image;
+    bool finite = std::isfinite(loss);
+    if (world_) {
+      // Decided together: a rank that skipped its backward alone would leave the others waiting.
+      const auto stats = torch::tensor({finite ? loss : 0.0, finite ? image_loss : 0.0, finite ? 0.0 : 1.0},
+                                       torch::kFloat64);
+      world_->allreduce_mean({stats});
+      finite = stats[2].item<double>() == 0;
+      loss = finite ? stats[0].item<double>() : NAN;
+      image_loss = stats[1].item<double>();
+    }
+    outcome.loss_curve.push_back(loss);
     lap(spent.forward_and_loss);
     if (finite) {
       terms.total.backward();
+      if (world_) {
+        std::vector<torch::Tensor> gradients;
+        for (const auto& p : params)
+          if (p.grad().defined()) gradients.push_back(p.grad());
+        world_->allreduce_mean(gradients);
+      }
       const double limit = schedule_.clip_grad_norm > 0 ? schedule_.clip_grad_norm : INFINITY;
       finite = std::isfinite(torch::nn::utils::clip_grad_norm_(params, limit));
     }
@@ -391,7 +450,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
     }
     lap(spent.optimizer);
     ++step;
-    progress.set_status("loss " + std::to_string(terms.image).substr(0, 8) + " lr " + std::to_string(lr).substr(0, 8));
+    progress.set_status("loss " + std::to_string(image_loss).substr(0, 8) + " lr " + std::to_string(lr).substr(0, 8));
     progress.advance();
 
     const bool last = step == schedule_.steps;
@@ -407,7 +466,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
                    score.ssim, outcome.best.psnr, outcome.best.step);
       lap(spent.validation);
     }
-    if (checkpoint && (step % schedule_.checkpoint_every == 0 || last)) {
+    if (checkpoint && (!world_ || world_->coordinator()) && (step % schedule_.checkpoint_every == 0 || last)) {
       save_checkpoint(*checkpoint, step, outcome);
       lap(spent.checkpoint);
     }

@@ -25,6 +25,10 @@
 
 namespace cgsr {
 
+namespace distributed {
+class World;
+}
+
 struct TrainSchedule {
   int steps = 2000;
   int batch_size = 16;
@@ -67,6 +71,7 @@ struct TrainOutcome {
   double patches_per_second = 0;
   ValidationScore best, last;
   std::vector<ValidationScore> history;
+  std::vector<double> loss_curve;  // training loss (the CGSR total) of every step, over the global batch
   bool resumed = false;
   std::string layout;  // the memory layout the steps ran in
   StepPhases phase_ms;  // over the steps this run took (a resumed run: since the resume)
@@ -102,6 +107,13 @@ class Trainer {
 
   SRNetwork network() const { return network_; }
 
+  // Data-parallel training over the ranks of `world`, each with the same network, data and
+  // schedule: every rank draws the global batch a 1-process run draws at that step and trains on
+  // its equal slice (batch_size must split evenly); losses and gradients are averaged over the
+  // ranks by allreduce, so every rank takes the same optimizer step. Rank 0 alone writes the
+  // checkpoint; a resume hands rank 0's checkpoint to every rank.
+  void set_data_parallel(distributed::World* world) { world_ = world; }
+
   // Writes the weights of the final step (the network itself holds the best ones after run()).
   void save_last_model(const std::filesystem::path& path, const Provenance& provenance) const;
 
@@ -125,6 +137,7 @@ class Trainer {
   MemoryLayout layout_ = MemoryLayout::Nchw;  // where run() keeps parameters and batches
   std::unique_ptr<torch::optim::Adam> optimizer_;
   std::vector<torch::Tensor> best_weights_, last_weights_;
+  distributed::World* world_ = nullptr;
 };
 
 }  // namespace cgsr

@@ -14,6 +14,7 @@
 #include "cli/commands/render.h"
 #include "cli/commands/report.h"
 #include "cli/commands/search.h"
+#include "cli/distributed_run.h"
 #include "cli/commands/train.h"
 #include "cli/stage_cache.h"
 #include "core/atomic_file.h"
@@ -138,7 +139,8 @@ class StageRunner {
     ++index_;
     forcing_ = forcing_ || stage == from_;
     StageOutcome outcome;
-    outcome.hash = stage_hash(cache_form.IsDefined() && !cache_form.IsNull() ? cache_form : resolved, upstream);
+    outcome.hash =
+        stage_hash(without_distribution(cache_form.IsDefined() && !cache_form.IsNull() ? cache_form : resolved), upstream);
     const fs::path where = dir(stage);
     if (!forcing_ && stage_is_current(where, outcome.hash)) {
       spdlog::info("[{}/{}] {}: up to date in {}, skipped", index_, total_, stage, where.string());
@@ -302,6 +304,13 @@ class Pipeline {
     search_filled["parent"] = model_file("enhance").string();
     search_ = parse_stage(options_.search, search_command_schema(), search_filled, "search");
     eval_ = parse_stage(options_.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
+    // A distributed stage's other ranks are `cgsr search` / `cgsr train` processes (docs/distributed.md).
+    for (const auto& [stage, rank] : {std::pair<const char*, int>{"train", backbone_.distributed.rank},
+                                      {"enhance", enhanced_.distributed.rank}, {"search", search_.distributed.rank}})
+      if (rank != 0)
+        throw Error(std::string(stage) + ".distributed.rank",
+                    "cgsr run is rank 0 of a distributed stage; start the other ranks with cgsr " +
+                        std::string(stage == std::string("search") ? "search" : "train") + " (docs/distributed.md)");
     // The stages that evaluate (prune, eval, heldout) leave latency out: the report stage times
     // every model side by side, which is the only timing that compares.
     stage_eval_ = eval_;

@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "cli/distributed_run.h"
+#include "cli/distributed_search.h"
+#include "core/hash.h"
+#include "core/atomic_file.h"
 #include "core/plot.h"
 #include "core/yaml_json.h"
 #include "models/block_importance.h"
@@ -22,6 +26,8 @@ config::Schema<SearchCommandOptions> search_command_schema() {
   s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
   s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
   s.field("resume", &SearchCommandOptions::resume, "continue from history.jsonl and the final checkpoint");
+  s.section("distributed", &SearchCommandOptions::distributed, distributed::distributed_schema(),
+            "train candidates on several processes or machines (docs/distributed.md)");
   add_run_settings(s);
   return s;
 }
@@ -35,11 +41,15 @@ void setup_search(CLI::App& app) {
         flag_to_key(sub, flags, "--data", "data", "data set directory");
         flag_to_key(sub, flags, "--strategy", "strategy", "evolution or random (with its default options)");
         switch_to_key(sub, flags, "--resume", "resume", "continue an interrupted search in --out");
+        add_distributed_flags(sub, flags);
       },
       [](const SearchCommandOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
         return run_search_command(options, resolved, *run_dir);
       },
-      /*always_run_dir=*/true);
+      /*always_run_dir=*/true,
+      [](const SearchCommandOptions& options, const std::filesystem::path& out) {
+        return rank_run_dir(options.distributed, out);
+      });
 }
 
 YAML::Node search_config_cache_form(const YAML::Node& resolved) {
@@ -103,15 +113,52 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   if (!parent.network->has_rit())
     spdlog::warn("{}: the parent has no RIT block; the search runs on the plain backbone", options.parent);
 
-  SearchHistory history(run_dir.file("history.jsonl"), options.resume);
   std::vector<int> drop_order;
   if (options.search.space.drop_blocks == BlockDrop::Importance && parent.network->spec().blocks > 0) {
     drop_order = block_drop_order(*parent.network);
     spdlog::info("search: shallower candidates drop the parent's blocks in the order {} (least important first)",
                  fmt::join(drop_order, ", "));
   }
-  TrainingEvaluator evaluator(parent.network, data, options.candidate, drop_order);
-  const SearchResult result = run_search(parent.network->spec(), evaluator, history, options.search);
+  TrainingEvaluator local(parent.network, data, options.candidate, drop_order);
+  // Rank 0 opens the history before the others join: a refused --out fails before they wait.
+  std::optional<SearchHistory> history;
+  if (!options.distributed.enabled() || options.distributed.rank == 0)
+    history.emplace(run_dir.file("history.jsonl"), options.resume);
+  std::unique_ptr<distributed::World> world;
+  std::optional<distributed::WorkQueue> queue;
+  std::optional<DistributedEvaluator> distributed_evaluator;
+  if (options.distributed.enabled()) {
+    // What a candidate's score depends on: every rank must agree on it.
+    const std::string job = std::to_string(fnv1a64(read_file(options.parent))) + "\n" +
+                            std::to_string(data.frames(Split::Train).size()) + " " +
+                            std::to_string(data.frames(Split::Val).size()) + "\n" + std::to_string(options.seed) +
+                            "\n" + config::to_yaml(candidate_training_schema().emit(options.candidate));
+    world = join_run(options.distributed, job);
+    queue.emplace(*world);
+    if (options.candidate.schedule.layout == "auto")
+      spdlog::warn("candidate.schedule.layout is auto: each process measures its own memory layout, so a score can "
+                   "differ in the last digits from a 1-process run (set nchw or nhwc for identical ones)");
+    if (!world->coordinator()) {
+      const int trained = serve_candidates(*queue, local);
+      spdlog::info("distributed: {} trained {} candidate(s); rank 0 records the search", world->describe(), trained);
+      nlohmann::ordered_json j;
+      j["rank"] = world->rank();
+      j["world_size"] = world->size();
+      j["candidates_trained"] = trained;
+      return j;
+    }
+    distributed_evaluator.emplace(local, *queue);
+  }
+  Evaluator& evaluator = distributed_evaluator ? static_cast<Evaluator&>(*distributed_evaluator) : local;
+
+  SearchResult result;
+  try {
+    result = run_search(parent.network->spec(), evaluator, *history, options.search);
+  } catch (const std::exception& e) {
+    if (queue) queue->abort(e.what());
+    throw;
+  }
+  if (queue) queue->finish();  // the other ranks return; rank 0 trains the pick alone
   write_population_plot(run_dir.file("population.png"), result);
   if (result.pick_is_parent)
     spdlog::warn("no candidate stayed within {} dB of the parent; the parent is kept", options.search.tolerance_db);
@@ -151,6 +198,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   j["generations"] = result.generations_run;
   j["stop_reason"] = result.stop_reason;
   j["final_training"] = to_json(final_training);
+  if (world) j["world_size"] = world->size();
   return j;
 }
 

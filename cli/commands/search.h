@@ -7,6 +7,7 @@
 
 #include "cli/command.h"
 #include "cli/training_evaluator.h"
+#include "distributed/world.h"
 #include "search/search_loop.h"
 
 namespace cgsr::cli {
@@ -19,6 +20,7 @@ struct SearchCommandOptions : RunSettings {
   TrainSchedule final_schedule;  // training of the pick (paper: 30 epochs)
   std::string name;              // display name of the result
   bool resume = false;
+  distributed::DistributedOptions distributed;  // candidates spread over processes (docs/distributed.md)
 };
 
 config::Schema<SearchCommandOptions> search_command_schema();

@@ -2,6 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "cli/distributed_run.h"
+#include "core/atomic_file.h"
+#include "core/hash.h"
 #include "core/yaml_json.h"
 #include "models/complexity.h"
 #include "models/inherit.h"
@@ -32,6 +35,8 @@ config::Schema<TrainOptions> train_schema_with(
   s.section("schedule", &TrainOptions::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &TrainOptions::loss, loss_schema(), "CGSR loss weights");
   s.field("resume", &TrainOptions::resume, "continue from checkpoint.pt in the run directory");
+  s.section("distributed", &TrainOptions::distributed, distributed::distributed_schema(),
+            "data-parallel training on several processes or machines (docs/distributed.md)");
   add_run_settings(s);
   return s;
 }
@@ -72,12 +77,29 @@ void setup_train(CLI::App& app) {
         flag_to_key(sub, flags, "--model", "model", "backbone name, spec file or model file");
         flag_to_key(sub, flags, "--steps", "schedule.steps", "optimizer steps");
         switch_to_key(sub, flags, "--resume", "resume", "continue from the run directory's checkpoint");
+        add_distributed_flags(sub, flags);
       },
       [](const TrainOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
         return run_train(options, resolved, *run_dir);
       },
-      /*always_run_dir=*/true);
+      /*always_run_dir=*/true,
+      [](const TrainOptions& options, const std::filesystem::path& out) {
+        return rank_run_dir(options.distributed, out);
+      });
 }
+
+namespace {
+// One line per optimizer step: the training loss over the global batch (NaN for a skipped step).
+void write_loss_curve(const std::filesystem::path& path, const TrainOutcome& outcome) {
+  std::string text = "step,loss\n";
+  char line[64];
+  for (size_t i = 0; i < outcome.loss_curve.size(); ++i) {
+    std::snprintf(line, sizeof line, "%zu,%.9g\n", i + 1, outcome.loss_curve[i]);
+    text += line;
+  }
+  write_file_atomic(path, text);
+}
+}  // namespace
 
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
   const Dataset data = Dataset::open(options.data);
@@ -97,7 +119,29 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
                data.frames(Split::Train).size(), data.frames(Split::Val).size());
 
   Trainer trainer(network, data, options.schedule, options.loss);
+  std::unique_ptr<distributed::World> world;
+  if (options.distributed.enabled()) {
+    // What the training depends on, paths aside (they may differ between machines).
+    TrainOptions job = options;
+    job.data.clear();
+    job.distributed = {};
+    job.threads = 0;  // compared separately (a warning)
+    if (source.kind == ModelSource::Kind::ModelFile) job.model = std::to_string(fnv1a64(read_file(options.model)));
+    world = join_run(options.distributed, config::to_yaml(train_schema().emit(job)) + "\n" +
+                                              std::to_string(data.frames(Split::Train).size()) + " " +
+                                              std::to_string(data.frames(Split::Val).size()));
+    trainer.set_data_parallel(world.get());
+  }
   const TrainOutcome outcome = trainer.run(run_dir.file("checkpoint.pt"), options.resume);
+  if (world && !world->coordinator()) {
+    // Rank 0 writes the model files; this rank only reports its part.
+    nlohmann::ordered_json results;
+    results["rank"] = world->rank();
+    results["world_size"] = world->size();
+    results["training"] = to_json(outcome);
+    return results;
+  }
+  write_loss_curve(run_dir.file("loss_curve.csv"), outcome);
 
   Provenance provenance;
   provenance.stage = stage;
@@ -115,6 +159,7 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
   results["params"] = inference_parameter_count(*network);
   results["model"] = run_dir.file("model.cgsr").string();
   results["training"] = to_json(outcome);
+  if (world) results["world_size"] = world->size();
   spdlog::info("{}: best validation {:.3f} dB / {:.4f} at step {}; {:.1f} patches/s", name, outcome.best.psnr,
                outcome.best.ssim, outcome.best.step, outcome.patches_per_second);
   return results;

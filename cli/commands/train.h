@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
+#include "distributed/world.h"
 #include "models/arch_spec.h"
 #include "train/losses.h"
 #include "train/trainer.h"
@@ -27,6 +28,7 @@ struct TrainOptions : RunSettings {
   TrainSchedule schedule;
   LossOptions loss;
   bool resume = false;       // continue from checkpoint.pt in --out
+  distributed::DistributedOptions distributed;  // data-parallel over processes (docs/distributed.md)
 };
 
 config::Schema<TrainOptions> train_schema();
