@@ -164,7 +164,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
     spdlog::warn("no candidate stayed within {} dB of the parent; the parent is kept", options.search.tolerance_db);
 
   // The CG-optimized network: the pick, inherited from the parent and trained longer.
-  SRNetwork picked = inherit(*parent.network, result.pick.spec, {}, evaluator.parent_blocks(result.pick.spec)).network;
+  SRNetwork picked = inherit(*parent.network, result.pick.spec, {}, local.parent_blocks(result.pick.spec)).network;
   Trainer trainer(picked, data, options.final_schedule, options.candidate.loss);
   const TrainOutcome final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
 
