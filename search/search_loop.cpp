@@ -12,7 +12,6 @@
 
 namespace cgsr {
 
-namespace {
 // Before each strategy had its own options block, evolution's options were a shared `operators:`
 // block next to `strategy: evolution`; they now sit in the strategy block.
 YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cursor& at) {
@@ -42,7 +41,6 @@ YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cur
   if (!given) out["strategy"] = strategy;
   return out;
 }
-}  // namespace
 
 config::Schema<SearchOptions> search_schema() {
   config::Schema<SearchOptions> s;

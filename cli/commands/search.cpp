@@ -22,6 +22,7 @@ config::Schema<SearchCommandOptions> search_command_schema() {
   s.field("data", &SearchCommandOptions::data, "data set directory").required();
   s.inline_section(&SearchCommandOptions::search, search_schema());
   s.moved_block("search");  // configs before the search options moved up: `search: {strategy: ...}`
+  s.upgrade(move_operators_into_strategy);  // lifted from `search:` or at the top
   s.section("candidate", &SearchCommandOptions::candidate, candidate_training_schema(), "training of each candidate");
   s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
   s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
