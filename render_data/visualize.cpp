@@ -101,4 +101,23 @@ torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<Previe
   return canvas;
 }
 
+torch::Tensor tile_frames(const std::vector<Frame>& frames, PreviewChannel channel, int columns) {
+  if (frames.empty() || columns < 1) throw Error("preview", "a grid needs at least one frame and one column");
+  const int W = frames[0].width, H = frames[0].height, gap = 4;
+  const int cols = std::min<int>(columns, static_cast<int>(frames.size()));
+  const int rows = (static_cast<int>(frames.size()) + cols - 1) / cols;
+  auto canvas = torch::ones({3, static_cast<int64_t>(rows) * (H + gap) - gap, static_cast<int64_t>(cols) * (W + gap) - gap});
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (frames[i].width != W || frames[i].height != H)
+      throw Error("preview", "frame " + std::to_string(i) + " of the grid is " + std::to_string(frames[i].width) + "x" +
+                                 std::to_string(frames[i].height) + ", the first is " + std::to_string(W) + "x" +
+                                 std::to_string(H));
+    if (!shows(frames[i], channel))
+      throw Error("preview", "a frame of the grid has no '" + preview_channel_names()[static_cast<size_t>(channel)] + "' channel");
+    const int64_t y = static_cast<int64_t>(i / cols) * (H + gap), x = static_cast<int64_t>(i % cols) * (W + gap);
+    canvas.slice(1, y, y + H).slice(2, x, x + W).copy_(visualize(frames[i], channel));
+  }
+  return canvas;
+}
+
 }  // namespace cgsr

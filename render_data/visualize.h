@@ -25,4 +25,8 @@ torch::Tensor visualize(const Frame& frame, PreviewChannel channel, double motio
 // for an integer s.
 torch::Tensor montage(const Frame& lr, const Frame& hr, const std::vector<PreviewChannel>& channels);
 
+// A grid of frames of one size (e.g. many scenes of a multi-scene data set), row by row,
+// `columns` per row, one channel each, 4-pixel white gaps.
+torch::Tensor tile_frames(const std::vector<Frame>& frames, PreviewChannel channel, int columns);
+
 }  // namespace cgsr

@@ -1,6 +1,7 @@
 #pragma once
 // `cgsr data preview DIR --frame N --out FILE.png`: a montage of one frame, LR (pixels enlarged)
-// beside HR, one row per channel (colour, depth, normals, edges, ...).
+// beside HR, one row per channel (colour, depth, normals, edges, ...). With `frames: [...]`, a
+// grid of those frames instead (one channel, at one resolution): e.g. the scenes of a scene set.
 
 #include <CLI/CLI.hpp>
 
@@ -17,6 +18,9 @@ struct DataPreviewOptions : RunSettings {
   std::vector<std::string> channels = {"color", "depth", "normal", "edge"};
   std::string crop;      // "x,y,w,h" in HR pixels (multiples of the scale); empty: whole frame
   std::string image;     // output PNG
+  std::vector<int> frames;  // grid mode: these frames, `columns` per row, at `resolution`
+  int columns = 4;
+  std::string resolution;   // grid mode: WxH of the tiles; empty: the smallest
   DatasetOpenOptions open;
 };
 

@@ -15,6 +15,9 @@ config::Schema<SceneSetEntry> scene_set_entry_schema() {
   s.field("weight", &SceneSetEntry::weight, "sampling weight (0 for every scene: in proportion to training frames)")
       .at_least(0);
   s.field("frames", &SceneSetEntry::frames, "frames to render (0: the config's)").range(0, 1000000);
+  s.field("set", &SceneSetEntry::set, "overrides of the scene config, key.path=value as --set (e.g. scene.variant=3)");
+  // Entries without overrides resolve as before the key existed.
+  s.omit_when("set", [](const SceneSetEntry& e) { return e.set.empty(); });
   return s;
 }
 
@@ -26,7 +29,7 @@ config::Schema<RenderOptions> render_schema() {
   config::Schema<RenderOptions> s;
   add_render_job_fields(s, /*scene_required=*/false);
   s.list("scenes", &RenderOptions::scenes, scene_set_entry_schema(),
-         "a scene set instead of 'scene': [{config, name, weight, frames}], rendered into one data set");
+         "a scene set instead of 'scene': [{config, name, weight, frames, set}], rendered into one data set");
   s.validate([](const RenderOptions& o, const config::Cursor& at, const YAML::Node& node) {
     const bool has_scene = o.scene.node && !o.scene.node.IsNull();
     if (o.scenes.empty()) {
@@ -78,7 +81,9 @@ namespace {
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options) {
   std::vector<SceneRenderJob> jobs;
   for (const auto& entry : options.scenes) {
-    const RenderOptions scene = config::parse_document(config::Document::load_file(entry.config), render_schema());
+    config::Document document = config::Document::load_file(entry.config);
+    for (const auto& assignment : entry.set) document.apply_override(assignment, entry.config + ": set " + assignment);
+    const RenderOptions scene = config::parse_document(document, render_schema());
     if (!scene.scenes.empty()) throw Error(entry.config, "is a scene set itself; list its scene configs instead");
     SceneRenderJob job;
     job.options = scene;

@@ -9,6 +9,7 @@
 //   scenes:
 //     - {config: configs/scenes/default.yaml}
 //     - {config: configs/scenes/arena.yaml, weight: 2, frames: 60}   # name, weight, frames optional
+//     - {config: configs/scenes/variety.yaml, name: variety_3, set: [scene.variant=3]}   # overrides
 // Each entry is a scene config as above, rendered as it says (with the command's seed) into
 // DIR/scenes/<name>; DIR/manifest.yaml lists the scenes (dataset_manifest.h).
 
@@ -25,6 +26,7 @@ struct SceneSetEntry {
   std::string name;    // empty: the config's name, else the file's stem
   double weight = 0;   // sampling weight; 0 for every entry: proportional to training frames
   int frames = 0;      // 0: the config's
+  std::vector<std::string> set;  // "key.path=value" overrides of the config, as --set (e.g. scene.variant=3)
 };
 
 struct RenderOptions : RunSettings, RenderJobOptions {

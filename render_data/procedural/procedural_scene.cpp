@@ -6,9 +6,13 @@
 #include <set>
 #include <tuple>
 
+#include <spdlog/spdlog.h>
+
 #include "core/error.h"
 #include "render_data/procedural/mesh_builder.h"
+#include "render_data/procedural/procedural_rng.h"
 #include "render_data/procedural/procedural_textures.h"
+#include "render_data/procedural/procedural_variety.h"
 #include "render_data/scene_source.h"
 #include "render_data/vec_math.h"
 
@@ -16,20 +20,7 @@ namespace cgsr {
 namespace {
 
 
-class Rng {
- public:
-  explicit Rng(uint64_t seed) : engine_(seed ^ 0x5DEECE66DULL) {}
-  double uniform() { return static_cast<double>(engine_() >> 11) * (1.0 / 9007199254740992.0); }
-  float range(float lo, float hi) { return lo + static_cast<float>(uniform()) * (hi - lo); }
-  int below(int n) { return std::min(n - 1, static_cast<int>(uniform() * n)); }
-  bool chance(double p) { return uniform() < p; }
-  uint64_t bits() { return engine_(); }
-  template <class T>
-  const T& pick(const std::vector<T>& v) { return v[below(static_cast<int>(v.size()))]; }
-
- private:
-  std::mt19937_64 engine_;
-};
+using Rng = ProceduralRng;
 
 Vec3 vec3(const std::vector<float>& v) { return {v[0], v[1], v[2]}; }
 
@@ -40,6 +31,7 @@ struct Grid {
   int nx = 0, nz = 0;
   float cell = 1;
   std::vector<uint8_t> kind;
+  std::vector<float> height;  // per wall cell: its own height (outdoor buildings); 0: the level's wall height
   bool inside(int x, int z) const { return x >= 0 && z >= 0 && x < nx && z < nz; }
   uint8_t& at(int x, int z) { return kind[static_cast<size_t>(z) * nx + x]; }
   uint8_t get(int x, int z) const { return inside(x, z) ? kind[static_cast<size_t>(z) * nx + x] : static_cast<uint8_t>(Wall); }
@@ -53,8 +45,13 @@ class LevelBuilder {
     grid_.nz = o.size[1];
     grid_.cell = o.cell;
     grid_.kind.assign(static_cast<size_t>(grid_.nx) * grid_.nz, Free);
+    grid_.height.assign(grid_.kind.size(), 0.0f);
     arena_ = o.layout == "arena";
-    ceiling_ = o.ceiling && !arena_;
+    hall_ = o.layout == "hall";
+    outdoor_ = o.layout == "outdoor";
+    open_sky_ = arena_ || outdoor_;
+    variety_ = o.variety.enabled;
+    ceiling_ = o.ceiling && !open_sky_;
     wall_height_ = arena_ ? std::min(o.height, 1.4f) : o.height;
     uv_ = o.texel_density / static_cast<float>(o.texture_size);
   }
@@ -63,6 +60,8 @@ class LevelBuilder {
     scene_.name = o_.name;
     if (o_.layout == "room") layout_room();
     else if (o_.layout == "corridors") layout_corridors();
+    else if (o_.layout == "hall") layout_hall();
+    else if (o_.layout == "outdoor") layout_outdoor();
     else layout_arena();
     build_structure();
     const auto walk = camera_walk();
@@ -106,8 +105,20 @@ class LevelBuilder {
     return static_cast<int>(scene_.materials.size() - 1);
   }
   Vec3 pick_colour(const std::vector<Vec3>& palette) { return rng_.pick(palette); }
+  // Variety: a texture family without holes, random colours and gloss.
+  int family_material() {
+    std::vector<TextureKind> solid;
+    for (const auto& name : o_.variety.materials)
+      if (!texture_kind_has_holes(texture_kind_from_name(name))) solid.push_back(texture_kind_from_name(name));
+    const TextureKind kind = rng_.pick(solid);
+    Vec3 base, accent;
+    random_albedo(rng_, base, accent);
+    const float specular = rng_.chance(0.3) ? rng_.range(0.3f, 0.8f) : rng_.range(0.0f, 0.2f);
+    return material(kind, base, accent, specular, rng_.range(8.0f, 96.0f));
+  }
 
   int wall_material() {
+    if (wall_mat_ < 0 && variety_) wall_mat_ = family_material();
     if (wall_mat_ < 0) {
       const TextureKind kind = rng_.pick(std::vector<TextureKind>{TextureKind::Bricks, TextureKind::Bricks,
                                                                    TextureKind::Plates, TextureKind::Noise});
@@ -184,44 +195,131 @@ class LevelBuilder {
       if (grid_.inside(x, z)) grid_.at(x, z) = Wall;
     }
   }
+  void layout_hall() {
+    // One large high room with a colonnade: columns in every third cell, two cells from the
+    // walls. Column cells count as walls for the camera walk and are built as round columns.
+    border_walls();
+    const int offset = 2 + rng_.below(2);
+    for (int z = offset; z < grid_.nz - 2; z += 3)
+      for (int x = offset; x < grid_.nx - 2; x += 3) {
+        grid_.at(x, z) = Wall;
+        columns_.insert(z * grid_.nx + x);
+      }
+  }
+  void layout_outdoor() {
+    // Open ground under the sky with buildings of different heights (blocks of 1-3 x 1-2 cells);
+    // the camera walks the streets between them. No boundary wall: the grid's edge stops the walk.
+    const int buildings = std::max(1, grid_.nx * grid_.nz / 14);
+    for (int i = 0; i < buildings; ++i) {
+      const bool wide = rng_.chance(0.5);
+      const int w = wide ? rng_.between(1, 3) : rng_.between(1, 2), d = wide ? rng_.between(1, 2) : rng_.between(1, 3);
+      const int x0 = rng_.below(std::max(1, grid_.nx - w)), z0 = rng_.below(std::max(1, grid_.nz - d));
+      const float h = rng_.range(3.0f, 10.0f);
+      for (int z = z0; z < std::min(grid_.nz, z0 + d); ++z)
+        for (int x = x0; x < std::min(grid_.nx, x0 + w); ++x) {
+          grid_.at(x, z) = Wall;
+          grid_.height[static_cast<size_t>(z) * grid_.nx + x] = h;
+        }
+    }
+  }
+  bool is_column(int x, int z) const { return columns_.count(z * grid_.nx + x) > 0; }
 
   // ---- walls, floor, ceiling ------------------------------------------------------------------------
   void build_structure() {
     const float c = grid_.cell, W = grid_.nx * c, D = grid_.nz * c;
-    // Walls: runs of wall cells along x merged into one box each.
-    MeshBuilder walls("walls", wall_material(), object());
+    // Walls: runs of wall cells (of one height) along x merged into one box each. With variety,
+    // runs and buildings take one of up to three wall materials.
+    std::vector<MeshBuilder> walls{MeshBuilder("walls", wall_material(), object())};
+    for (int extra = variety_ ? rng_.below(3) : 0; extra > 0; --extra)
+      walls.emplace_back("walls", family_material(), object());
+    auto cell_height = [&](int x, int z) { return grid_.height[static_cast<size_t>(z) * grid_.nx + x]; };
+    auto is_wall = [&](int x, int z) { return grid_.at(x, z) == Wall && !is_column(x, z); };
     for (int z = 0; z < grid_.nz; ++z)
       for (int x = 0; x < grid_.nx;) {
-        if (grid_.at(x, z) != Wall) {
+        if (!is_wall(x, z)) {
           ++x;
           continue;
         }
         int end = x;
-        while (end < grid_.nx && grid_.at(end, z) == Wall) ++end;
+        while (end < grid_.nx && is_wall(end, z) && cell_height(end, z) == cell_height(x, z)) ++end;
         // Interior blocks of an arena are lower than its boundary.
         const bool boundary = z == 0 || z == grid_.nz - 1 || x == 0 || end == grid_.nx;
-        const float h = arena_ && !boundary ? 0.9f : wall_height_;
-        walls.box({x * c, 0, z * c}, {end * c, h, (z + 1) * c}, uv_);
+        const float h = cell_height(x, z) > 0 ? cell_height(x, z) : arena_ && !boundary ? 0.9f : wall_height_;
+        // A building keeps one material on all its rows (its height tells it apart).
+        const size_t which = walls.size() == 1       ? 0
+                             : cell_height(x, z) > 0 ? static_cast<size_t>(h * 7) % walls.size()
+                                                     : static_cast<size_t>(rng_.below(static_cast<int>(walls.size())));
+        walls[which].box({x * c, 0, z * c}, {end * c, h, (z + 1) * c}, uv_);
         x = end;
       }
-    add(walls);
+    for (auto& w : walls) add(w);
+    if (!columns_.empty()) build_columns();
+    if (outdoor_) build_skyline();
 
-    const TextureKind floor_kind =
-        rng_.pick(std::vector<TextureKind>{TextureKind::Tiles, TextureKind::Checker, TextureKind::Planks});
-    const int floor_mat = material(floor_kind, pick_colour({{0.6f, 0.58f, 0.52f}, {0.42f, 0.3f, 0.2f}, {0.5f, 0.52f, 0.55f}}),
-                                   {0.25f, 0.24f, 0.22f}, 0.15f, 32);
+    int floor_mat;
+    if (variety_) {
+      floor_mat = family_material();
+    } else {
+      const TextureKind floor_kind =
+          rng_.pick(std::vector<TextureKind>{TextureKind::Tiles, TextureKind::Checker, TextureKind::Planks});
+      floor_mat = material(floor_kind, pick_colour({{0.6f, 0.58f, 0.52f}, {0.42f, 0.3f, 0.2f}, {0.5f, 0.52f, 0.55f}}),
+                           {0.25f, 0.24f, 0.22f}, 0.15f, 32);
+    }
     MeshBuilder floor("floor", floor_mat, object());
-    // Arenas: the ground continues beyond the boundary to the horizon.
-    const float margin = arena_ ? 4 * std::max(W, D) : 0;
+    // Under the sky the ground continues beyond the level to the horizon.
+    const float margin = open_sky_ ? 4 * std::max(W, D) : 0;
     floor.quad({-margin, 0, D + margin}, {W + 2 * margin, 0, 0}, {0, 0, -(D + 2 * margin)}, uv_);
     add(floor);
     if (ceiling_) {
-      const int ceil_mat = material(rng_.chance(0.5) ? TextureKind::Plates : TextureKind::Noise,
-                                    {0.55f, 0.55f, 0.56f}, {0.3f, 0.3f, 0.32f}, 0.05f, 16);
+      const int ceil_mat = variety_ ? family_material()
+                                    : material(rng_.chance(0.5) ? TextureKind::Plates : TextureKind::Noise,
+                                               {0.55f, 0.55f, 0.56f}, {0.3f, 0.3f, 0.32f}, 0.05f, 16);
       MeshBuilder ceiling("ceiling", ceil_mat, object());
       ceiling.quad({0, wall_height_, 0}, {W, 0, 0}, {0, 0, D}, uv_);
       add(ceiling);
     }
+    if (hall_ && wall_height_ >= 6.0f) build_gallery();
+  }
+
+  // Hall columns: a round shaft on a square base under a square capital, floor to ceiling.
+  void build_columns() {
+    const int mat = variety_ ? family_material() : wall_material();
+    const float r = 0.22f * grid_.cell, h = wall_height_;
+    for (int key : columns_) {
+      const int x = key % grid_.nx, z = key / grid_.nx;
+      MeshBuilder b("column", mat, object());
+      const Vec3 foot = grid_.centre(x, z), pad{r + 0.15f, 0, r + 0.15f};
+      b.box(foot - pad, grid_.centre(x, z, 0.4f) + pad, uv_);
+      b.cylinder(grid_.centre(x, z, 0.4f), {0, h - 0.8f, 0}, r, 24, uv_);
+      b.box(grid_.centre(x, z, h - 0.4f) - pad, grid_.centre(x, z, h) + pad, uv_);
+      add(b);
+    }
+  }
+
+  // A hall's gallery: a slab along the first wall, well above the camera, with a railing.
+  void build_gallery() {
+    const float c = grid_.cell, y = wall_height_ * 0.5f, depth = std::min(1.5f, 0.6f * c);
+    MeshBuilder slab("gallery", wall_material(), object());
+    slab.box({c, y - 0.3f, c}, {(grid_.nx - 1) * c, y, c + depth}, uv_);
+    add(slab);
+    add_railing_between({c, y, c + depth - 0.05f}, {(grid_.nx - 1) * c, y, c + depth - 0.05f});
+  }
+
+  // Outdoors: tall blocks beyond the level's edge, a skyline for the long views.
+  void build_skyline() {
+    const float c = grid_.cell, W = grid_.nx * c, D = grid_.nz * c;
+    MeshBuilder b("skyline", wall_material(), object());
+    for (int i = 0; i < 16; ++i) {
+      const int side = i % 4;
+      const float along = rng_.range(-0.2f, 1.2f), away = rng_.range(2.0f, 8.0f) * c;
+      const float w = rng_.range(1.5f, 4.0f) * c, d = rng_.range(1.5f, 4.0f) * c, h = rng_.range(8.0f, 30.0f);
+      const Vec3 centre = side == 0   ? Vec3{along * W, 0, -away - d / 2}
+                          : side == 1 ? Vec3{along * W, 0, D + away + d / 2}
+                          : side == 2 ? Vec3{-away - w / 2, 0, along * D}
+                                      : Vec3{W + away + w / 2, 0, along * D};
+      b.box(centre - Vec3{w / 2, 0, d / 2}, centre + Vec3{w / 2, h, d / 2}, uv_);
+    }
+    add(b);
   }
 
   // ---- camera ---------------------------------------------------------------------------------------
@@ -309,7 +407,7 @@ class LevelBuilder {
   // ---- lights ---------------------------------------------------------------------------------------
   void add_lights() {
     const auto& L = o_.lighting;
-    if (L.sun || arena_) {
+    if (L.sun || open_sky_) {
       Light sun;
       sun.type = LightType::Directional;
       sun.direction = normalize(Vec3{rng_.range(-0.6f, 0.6f), -1.0f, rng_.range(-0.6f, 0.6f)});
@@ -321,7 +419,7 @@ class LevelBuilder {
     std::vector<std::pair<int, int>> cells;
     for (int z = 0; z < grid_.nz; ++z)
       for (int x = 0; x < grid_.nx; ++x)
-        if (grid_.at(x, z) == Free || (!arena_ && grid_.at(x, z) == Path)) cells.push_back({x, z});
+        if (grid_.at(x, z) == Free || (!open_sky_ && grid_.at(x, z) == Path)) cells.push_back({x, z});
     const int lamp_mat = flat_material({1.0f, 0.92f, 0.75f}, 0, 1, /*unlit=*/true);
     for (int i = 0; i < L.point_lights && !cells.empty(); ++i) {
       const int k = rng_.below(static_cast<int>(cells.size()));
@@ -329,9 +427,15 @@ class LevelBuilder {
       cells.erase(cells.begin() + k);
       Light light;
       light.type = LightType::Point;
-      const float y = arena_ ? 3.6f : wall_height_ - 0.45f;
+      // Hall lamps hang from cables at most 5 m above the floor.
+      const float y = open_sky_ ? 3.6f : hall_ ? std::min(wall_height_ - 0.45f, 5.0f) : wall_height_ - 0.45f;
       light.position = grid_.centre(x, z, y);
-      light.color = rng_.pick(std::vector<Vec3>{{1.0f, 0.85f, 0.65f}, {0.75f, 0.85f, 1.0f}, {1.0f, 0.95f, 0.9f}});
+      if (variety_ && rng_.chance(o_.variety.coloured_lights)) {
+        const float hue = rng_.range(0, 1);
+        light.color = hsv_colour(hue, rng_.range(0.45f, 0.85f), 1.0f);
+      } else {
+        light.color = rng_.pick(std::vector<Vec3>{{1.0f, 0.85f, 0.65f}, {0.75f, 0.85f, 1.0f}, {1.0f, 0.95f, 0.9f}});
+      }
       light.intensity = L.point_intensity;
       light.radius = 2.0f * grid_.cell;
       light.shadows = L.shadows;
@@ -339,7 +443,12 @@ class LevelBuilder {
       MeshBuilder lamp("lamp", lamp_mat, object());
       lamp.box(light.position + Vec3{-0.15f, 0.12f, -0.15f}, light.position + Vec3{0.15f, 0.25f, 0.15f}, 1.0f);
       add(lamp);
-      if (arena_) {  // lamp post (cells with posts become obstacles)
+      if (hall_ && y + 0.25f < wall_height_) {
+        MeshBuilder cable("wire", metal_material(), object());
+        cable.tube({light.position + Vec3{0, 0.25f, 0}, grid_.centre(x, z, wall_height_)}, 0.012f, 6, 1.0f);
+        add(cable);
+      }
+      if (open_sky_) {  // lamp post (cells with posts become obstacles)
         MeshBuilder post("lamp post", metal_material(), object());
         post.cylinder(grid_.centre(x, z), {0, y + 0.1f, 0}, 0.06f, 10, 1.0f);
         add(post);
@@ -349,7 +458,9 @@ class LevelBuilder {
   }
 
   // ---- props ----------------------------------------------------------------------------------------
-  bool take_cell(int& x, int& z, bool need_free_neighbour = false, int* dir_out = nullptr) {
+  // A free cell off the camera path (and a free neighbour, with its direction); when there is none,
+  // the prop is counted as skipped (an error at the end) unless `may_skip`.
+  bool take_cell(int& x, int& z, bool need_free_neighbour = false, int* dir_out = nullptr, bool may_skip = false) {
     std::vector<std::pair<int, int>> cells;
     for (int cz = 0; cz < grid_.nz; ++cz)
       for (int cx = 0; cx < grid_.nx; ++cx)
@@ -371,17 +482,45 @@ class LevelBuilder {
       grid_.at(x + kDx[*dir_out], z + kDz[*dir_out]) = Occupied;
       return true;
     }
-    ++skipped_props_;
+    if (!may_skip) ++skipped_props_;
     return false;
   }
 
+  // Variety: scales the props that need cells down until they take at most half of the free
+  // cells (a random size and layout may be much smaller than what the counts were made for);
+  // stairs, which need two free neighbouring cells, go first and only where such a pair is left.
+  void fit_props(ProceduralProps& p) const {
+    int free = 0;
+    for (uint8_t k : grid_.kind) free += k == Free;
+    int* counts[] = {&p.crates, &p.pillars, &p.spheres, &p.tori, &p.stairs, &p.fences, &p.railings, &p.grates};
+    int demand = p.stairs;  // stairs take two cells
+    for (int* n : counts) demand += *n;
+    if (demand <= free / 2) return;
+    const double factor = static_cast<double>(free / 2) / demand;
+    for (int* n : counts) *n = static_cast<int>(*n * factor);
+  }
+
+  void place_stairs(int count, bool may_skip) {
+    int x, z;
+    for (int i = 0; i < count; ++i) {
+      int dir = 0;
+      if (!take_cell(x, z, true, &dir, may_skip)) break;
+      add_stairs(x, z, dir);
+    }
+  }
+
   void add_props() {
-    const auto& p = o_.props;
+    ProceduralProps p = o_.props;
+    if (variety_) {
+      fit_props(p);
+      place_stairs(p.stairs, /*may_skip=*/true);  // first, while pairs of free cells are easy to find
+    }
     const float c = grid_.cell;
     int x, z;
     if (p.crates > 0) {
-      const int mat = material(rng_.chance(0.6) ? TextureKind::Planks : TextureKind::Stripes,
-                               {0.62f, 0.45f, 0.25f}, {0.2f, 0.14f, 0.08f}, 0.05f, 16);
+      const int mat = variety_ ? family_material()
+                               : material(rng_.chance(0.6) ? TextureKind::Planks : TextureKind::Stripes,
+                                          {0.62f, 0.45f, 0.25f}, {0.2f, 0.14f, 0.08f}, 0.05f, 16);
       for (int i = 0; i < p.crates && take_cell(x, z); ++i) {
         MeshBuilder b("crate", mat, object());
         float s = rng_.range(0.5f, 0.95f), y = 0;
@@ -397,8 +536,9 @@ class LevelBuilder {
       }
     }
     if (p.pillars > 0) {
-      const int mat = material(rng_.chance(0.5) ? TextureKind::Noise : TextureKind::Bricks, {0.7f, 0.68f, 0.62f},
-                               {0.45f, 0.43f, 0.4f}, 0.2f, 32);
+      const int mat = variety_ ? family_material()
+                               : material(rng_.chance(0.5) ? TextureKind::Noise : TextureKind::Bricks, {0.7f, 0.68f, 0.62f},
+                                          {0.45f, 0.43f, 0.4f}, 0.2f, 32);
       const float h = ceiling_ ? wall_height_ : 4.5f;
       for (int i = 0; i < p.pillars && take_cell(x, z); ++i) {
         MeshBuilder b("pillar", mat, object());
@@ -410,8 +550,10 @@ class LevelBuilder {
       }
     }
     if (p.spheres > 0) {
-      const int mat = material(TextureKind::Checker, pick_colour({{0.8f, 0.2f, 0.15f}, {0.15f, 0.35f, 0.8f}, {0.9f, 0.75f, 0.2f}}),
-                               {0.9f, 0.9f, 0.88f}, 0.5f, 64);
+      const int mat = variety_ ? family_material()
+                               : material(TextureKind::Checker,
+                                          pick_colour({{0.8f, 0.2f, 0.15f}, {0.15f, 0.35f, 0.8f}, {0.9f, 0.75f, 0.2f}}),
+                                          {0.9f, 0.9f, 0.88f}, 0.5f, 64);
       for (int i = 0; i < p.spheres && take_cell(x, z); ++i) {
         const float r = rng_.range(0.25f, 0.45f);
         float y = 1.3f;
@@ -427,7 +569,8 @@ class LevelBuilder {
       }
     }
     if (p.tori > 0) {
-      const int mat = material(TextureKind::Stripes, {0.85f, 0.7f, 0.1f}, {0.1f, 0.1f, 0.1f}, 0.7f, 96);
+      const int mat = variety_ ? family_material()
+                               : material(TextureKind::Stripes, {0.85f, 0.7f, 0.1f}, {0.1f, 0.1f, 0.1f}, 0.7f, 96);
       for (int i = 0; i < p.tori && take_cell(x, z); ++i) {
         const float major = rng_.range(0.4f, 0.6f), minor = rng_.range(0.07f, 0.13f);
         const float yaw = rng_.range(0, kPiF);
@@ -437,15 +580,12 @@ class LevelBuilder {
         add(b);
       }
     }
-    for (int i = 0; i < p.stairs; ++i) {
-      int dir = 0;
-      if (!take_cell(x, z, true, &dir)) break;
-      add_stairs(x, z, dir);
-    }
+    if (!variety_) place_stairs(p.stairs, /*may_skip=*/false);
     for (int i = 0; i < p.fences && take_cell(x, z); ++i) add_fence(x, z, rng_.below(4));
     for (int i = 0; i < p.railings && take_cell(x, z); ++i) add_railing(x, z, rng_.below(4), 0.0f);
     for (int i = 0; i < p.signs; ++i) add_sign();
     for (int i = 0; i < p.wires; ++i) add_wire();
+    for (int i = 0; i < p.grates && take_cell(x, z); ++i) add_grate(x, z, rng_.below(4));
     if (skipped_props_ > 0)
       throw Error("procedural scene '" + o_.name + "'",
                   std::to_string(skipped_props_) + " prop(s) did not fit: the level has too few free cells off the "
@@ -511,6 +651,20 @@ class LevelBuilder {
 
   void add_fence(int x, int z, int dir) {
     if (fence_mat_ < 0) fence_mat_ = material(TextureKind::ChainLink, {0.7f, 0.72f, 0.75f}, {0, 0, 0}, 0.4f, 48, 0.5f);
+    add_panel(x, z, dir, fence_mat_, "fence");
+  }
+
+  void add_grate(int x, int z, int dir) {
+    if (grate_mat_ < 0) {
+      Vec3 base{0.45f, 0.46f, 0.48f}, accent{0.42f, 0.26f, 0.14f};  // steel with rust
+      if (variety_) random_albedo(rng_, base, accent);
+      grate_mat_ = material(TextureKind::Grate, base, accent, 0.4f, 48, 0.5f);
+    }
+    add_panel(x, z, dir, grate_mat_, "grate");
+  }
+
+  // An alpha-tested panel (fence, grate) 2 m high on edge `dir` of cell (x, z), in a metal frame.
+  void add_panel(int x, int z, int dir, int panel_material, const std::string& name) {
     Vec3 a, b;
     cell_edge(x, z, dir, a, b);
     const Vec3 inward = (grid_.centre(x, z) - (a + b) * 0.5f) * 0.08f;
@@ -518,10 +672,10 @@ class LevelBuilder {
     b = b + inward;
     const float h = 2.0f;
     const int id = object();
-    MeshBuilder mesh("fence", fence_mat_, id);
+    MeshBuilder mesh(name, panel_material, id);
     mesh.quad(a, b - a, {0, h, 0}, 2.0f * o_.texel_density / o_.texture_size);
     add(mesh);
-    MeshBuilder frame("fence frame", metal_material(), id);
+    MeshBuilder frame(name + " frame", metal_material(), id);
     frame.cylinder(a, {0, h + 0.05f, 0}, 0.035f, 10, 1.0f);
     frame.cylinder(b, {0, h + 0.05f, 0}, 0.035f, 10, 1.0f);
     frame.tube({a + Vec3{0, h, 0}, b + Vec3{0, h, 0}}, 0.02f, 8, 1.0f);
@@ -536,11 +690,22 @@ class LevelBuilder {
         if (grid_.at(x, z) == Free || grid_.at(x, z) == Path)
           for (int d = 0; d < 4; ++d)
             if (grid_.get(x + kDx[d], z + kDz[d]) == Wall && grid_.inside(x + kDx[d], z + kDz[d]) &&
+                !is_column(x + kDx[d], z + kDz[d]) &&
                 !used_sign_.count(static_cast<int64_t>((z * grid_.nx + x) * 4 + d)))
               spots.push_back({{x, z}, d});
     if (spots.empty()) return;
     const auto [cell, dir] = rng_.pick(spots);
     used_sign_.insert(static_cast<int64_t>((cell.second * grid_.nx + cell.first) * 4 + dir));
+    if (sign_mat_.empty() && variety_) {
+      // Text panels and screens in random colours, and decals (posters, markings) of any family.
+      for (int i = 0; i < 2; ++i) {
+        Vec3 base, accent;
+        random_albedo(rng_, base, accent);
+        sign_mat_.push_back(material(TextureKind::Glyphs, base, accent, 0.2f, 32));
+        scene_.materials.back().unlit = rng_.chance(0.4);
+      }
+      for (int i = 0; i < 2; ++i) sign_mat_.push_back(family_material());
+    }
     if (sign_mat_.empty()) {
       sign_mat_.push_back(material(TextureKind::Glyphs, {0.95f, 0.9f, 0.4f}, {0.08f, 0.1f, 0.12f}, 0.2f, 32));
       sign_mat_.push_back(material(TextureKind::Glyphs, {0.3f, 0.95f, 0.5f}, {0.03f, 0.06f, 0.05f}, 0.0f, 1));
@@ -567,6 +732,12 @@ class LevelBuilder {
       int len = 0;
       while (len < 8 && grid_.get(x + kDx[d] * (len + 1), z + kDz[d] * (len + 1)) != Wall) ++len;
       if (len < 2) continue;
+      // Variety: poles stand on cell boundaries; keep them off the camera's walk.
+      auto on_path = [&](int cx, int cz) { return grid_.inside(cx, cz) && grid_.at(cx, cz) == Path; };
+      if (variety_ && !ceiling_ &&
+          (on_path(x, z) || on_path(x - kDx[d], z - kDz[d]) || on_path(x + kDx[d] * len, z + kDz[d] * len) ||
+           on_path(x + kDx[d] * (len + 1), z + kDz[d] * (len + 1))))
+        continue;
       const float top = ceiling_ ? wall_height_ - rng_.range(0.25f, 0.6f) : rng_.range(3.0f, 4.0f);
       const Vec3 step{kDx[d] * grid_.cell, 0, kDz[d] * grid_.cell};
       const Vec3 side{-step.z, 0, step.x};
@@ -598,7 +769,9 @@ class LevelBuilder {
   bool arena_ = false, ceiling_ = true;
   float wall_height_ = 4, uv_ = 1;
   int next_object_ = 1;
-  int wall_mat_ = -1, metal_mat_ = -1, fence_mat_ = -1, wire_mat_ = -1;
+  int wall_mat_ = -1, metal_mat_ = -1, fence_mat_ = -1, wire_mat_ = -1, grate_mat_ = -1;
+  bool hall_ = false, outdoor_ = false, open_sky_ = false, variety_ = false;
+  std::set<int> columns_;  // hall column cells (walls for the camera walk)
   std::vector<int> sign_mat_;
   std::set<int64_t> used_sign_;
   int skipped_props_ = 0;
@@ -615,6 +788,7 @@ config::Schema<ProceduralProps> props_schema() {
   s.field("railings", &ProceduralProps::railings, "railings of thin posts and rails").range(0, 500);
   s.field("wires", &ProceduralProps::wires, "sagging cables under the ceiling or between poles").range(0, 500);
   s.field("signs", &ProceduralProps::signs, "wall panels with glyph-like text").range(0, 500);
+  s.field("grates", &ProceduralProps::grates, "free-standing grate panels (alpha-tested bars, thin)").range(0, 500);
   return s;
 }
 
@@ -661,7 +835,10 @@ config::Schema<ProceduralFog> fog_schema() {
 config::Schema<ProceduralOptions> procedural_schema() {
   config::Schema<ProceduralOptions> s;
   s.field("name", &ProceduralOptions::name, "scene name");
-  s.field("layout", &ProceduralOptions::layout, "level layout").one_of({"room", "corridors", "arena"});
+  s.field("layout", &ProceduralOptions::layout, "level layout (random: drawn from variety.layouts)")
+      .one_of({"room", "corridors", "hall", "arena", "outdoor", "random"});
+  s.field("variant", &ProceduralOptions::variant, "0: the level of the render seed; N: another level of the same seed")
+      .range(0, 1000000000);
   s.field("size", &ProceduralOptions::size, "grid cells [x, z]")
       .range(3, 200)
       .check([](const std::vector<int>& v) { return v.size() == 2; }, "must be [cells_x, cells_z]");
@@ -677,25 +854,45 @@ config::Schema<ProceduralOptions> procedural_schema() {
   auto rgb = [](const std::vector<float>& v) { return v.size() == 3; };
   s.field("sky_horizon", &ProceduralOptions::sky_horizon, "sky colour at the horizon, linear RGB").range(0, 10).check(rgb, "must be [r, g, b]");
   s.field("sky_zenith", &ProceduralOptions::sky_zenith, "sky colour overhead, linear RGB").range(0, 10).check(rgb, "must be [r, g, b]");
+  s.section("variety", &ProceduralOptions::variety, variety_schema(),
+            "ranges the layout, size, materials, lights, fog and sky are drawn from per seed (procedural_variety.h)");
   s.validate([](const ProceduralOptions& o, const config::Cursor& at, const YAML::Node& node) {
-    if (o.layout != "arena" && o.height < o.camera.eye_height + 0.8f)
-      at.child("height").fail(node, "rooms and corridors need walls at least 0.8 m above the camera's eye height");
+    if (o.layout != "arena" && o.layout != "outdoor" && o.layout != "random" && !node["variety"] &&
+        o.height < o.camera.eye_height + 0.8f)
+      at.child("height").fail(node, "rooms, corridors and halls need walls at least 0.8 m above the camera's eye height");
   });
   return s;
 }
 
+uint64_t procedural_level_seed(const ProceduralOptions& options, uint64_t seed) {
+  if (options.variant == 0) return seed;  // the level every config made before variants existed
+  uint64_t x = seed ^ (0x9E3779B97F4A7C15ULL * static_cast<uint64_t>(options.variant));
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
 SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed) {
-  return LevelBuilder(options, seed).build();
+  const uint64_t level_seed = procedural_level_seed(options, seed);
+  ProceduralOptions drawn = options;
+  drawn.variety.enabled |= options.layout == "random";
+  const ProceduralOptions level = draw_variety(drawn, level_seed);
+  if (level.variety.enabled)  // what the seed drew, so a user can find a level again
+    spdlog::info("procedural scene '{}': {} layout, {}x{} cells, {} point lights, fog {}", level.name, level.layout,
+                 level.size[0], level.size[1], level.lighting.point_lights, level.fog.density > 0 ? "on" : "off");
+  return LevelBuilder(level, level_seed).build();
 }
 
 void register_procedural_scene_source(Registry<SceneSourceFactory>& registry) {
   registry.add(
       "procedural",
       [](const config::Block& block, uint64_t seed) {
-        const auto options = config::parse_block_options(block, procedural_schema());
+        auto options = config::parse_block_options(block, procedural_schema());
+        options.variety.enabled = block.node["variety"] && !block.node["variety"].IsNull();
         return make_procedural_scene(options, seed);
       },
-      "game-like levels (rooms, corridors, arenas) with props, lights and a camera fly-through");
+      "game-like levels (rooms, corridors, halls, arenas, outdoor streets) with props, lights and a camera "
+      "fly-through; a variety block draws them from the seed");
 }
 
 }  // namespace cgsr

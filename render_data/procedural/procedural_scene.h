@@ -3,7 +3,7 @@
 //
 //   scene:
 //     type: procedural
-//     layout: room          # room | corridors | arena
+//     layout: room          # room | corridors | hall | arena | outdoor | random
 //     size: [10, 8]         # grid cells along x and z
 //     cell: 2.5             # metres per cell
 //     props: {crates: 6, pillars: 4, spheres: 3, tori: 2, stairs: 1, fences: 2, railings: 2, wires: 4, signs: 3}
@@ -14,6 +14,11 @@
 // over free cells, smoothed by the Catmull-Rom path of scene.h, with yaw/pitch/roll sway and
 // speed changes; props are placed only in cells the path does not visit, so the camera never
 // passes through geometry. Same options + seed = same scene.
+//
+// Variety (procedural_variety.h): with a `variety` block (or `layout: random`) the layout, size,
+// heights, prop counts, material families and colours, pattern scale, lights, fog and sky are
+// drawn from the seed within the block's ranges, so one config gives a different level per seed;
+// `variant: N` picks another level of the same config and seed (scene sets list several).
 
 #include <cstdint>
 #include <string>
@@ -27,6 +32,24 @@ namespace cgsr {
 
 struct ProceduralProps {
   int crates = 6, pillars = 4, spheres = 3, tori = 2, stairs = 1, fences = 2, railings = 2, wires = 4, signs = 3;
+  int grates = 0;  // free-standing grate panels (alpha-tested bars), thin like fences
+};
+
+// Ranges the level's options are drawn from (procedural_variety.h); every [lo, hi] is inclusive.
+struct ProceduralVariety {
+  bool enabled = false;  // set when the scene block has `variety` or `layout: random`
+  std::vector<std::string> layouts = {"room", "corridors", "hall", "arena", "outdoor"};  // for layout: random
+  std::vector<int> size = {7, 14};                   // grid cells per side
+  std::vector<std::string> materials = {"bricks", "tiles", "checker", "noise", "planks", "glyphs", "plates",
+                                        "stripes", "grate", "grid",  "tread",   "hexes"};  // texture families
+  std::vector<float> pattern_scale = {0.6f, 2.0f};   // texel density multiplier (coarser .. finer patterns)
+  std::vector<float> brightness = {0.35f, 2.0f};     // multiplier of every light and the ambient
+  std::vector<int> lights = {1, 7};                  // point lights
+  float coloured_lights = 0.5f;                      // chance that a lamp has a saturated colour
+  float fog = 0.35f;                                 // chance of distance fog
+  std::vector<float> fog_density = {0.01f, 0.06f};   // per metre
+  std::vector<float> props = {0.5f, 1.5f};           // multiplier of the solid props' counts
+  std::vector<float> thin = {1.0f, 3.0f};            // multiplier of fences, railings, wires, grates
 };
 
 struct ProceduralLighting {
@@ -59,6 +82,7 @@ struct ProceduralFog {
 struct ProceduralOptions {
   std::string name = "procedural";
   std::string layout = "room";
+  int variant = 0;           // 0: the level of the render seed; N: another level from the same seed
   std::vector<int> size = {10, 8};
   float cell = 2.5f;
   float height = 4.0f;       // wall height (arena: boundary wall height)
@@ -71,12 +95,17 @@ struct ProceduralOptions {
   ProceduralFog fog;
   std::vector<float> sky_horizon = {0.55f, 0.65f, 0.8f};
   std::vector<float> sky_zenith = {0.15f, 0.3f, 0.65f};
+  ProceduralVariety variety;
 };
 
 config::Schema<ProceduralOptions> procedural_schema();
 
-// Builds the level; throws cgsr::Error when the layout leaves no room for the camera walk.
+// Builds the level (variety drawn first when enabled); throws cgsr::Error when the layout leaves
+// no room for the camera walk or the props.
 SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed);
+
+// The seed a level is built from: the render seed, mixed with `variant` when it is not 0.
+uint64_t procedural_level_seed(const ProceduralOptions& options, uint64_t seed);
 
 // Adds "procedural" to a scene-source registry (scene_sources() does, when it is first used).
 void register_procedural_scene_source(Registry<SceneSourceFactory>& registry);

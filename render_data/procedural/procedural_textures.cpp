@@ -56,7 +56,8 @@ Vec3 clamp01(Vec3 c) { return {std::clamp(c.x, 0.0f, 1.0f), std::clamp(c.y, 0.0f
 
 const std::vector<std::string>& texture_kind_names() {
   static const std::vector<std::string> names = {"bricks", "tiles",      "checker", "noise", "planks",
-                                                 "glyphs", "chain_link", "plates",  "stripes"};
+                                                 "glyphs", "chain_link", "plates",  "stripes",
+                                                 "grate",  "grid",       "tread",   "hexes"};
   return names;
 }
 
@@ -84,10 +85,12 @@ float tileable_noise(float x, float y, int period, int octaves, uint64_t seed) {
   return sum / norm;
 }
 
+bool texture_kind_has_holes(TextureKind kind) { return kind == TextureKind::ChainLink || kind == TextureKind::Grate; }
+
 Texture make_texture(TextureKind kind, int size, uint64_t seed, Vec3 base, Vec3 accent) {
   if (size < 16) throw Error("texture", "size must be at least 16 texels");
   const int N = size;
-  const bool rgba = kind == TextureKind::ChainLink;
+  const bool rgba = texture_kind_has_holes(kind);
   Canvas canvas(N, rgba ? 4 : 3);
   auto noise = [&](int x, int y, int octaves = 4) { return tileable_noise(x + 0.5f, y + 0.5f, N, octaves, seed); };
   const int line = std::max(1, N / 64);  // joint / seam width in texels
@@ -206,6 +209,65 @@ Texture make_texture(TextureKind kind, int size, uint64_t seed, Vec3 base, Vec3 
         for (int x = 0; x < N; ++x) {
           const float n = noise(x, y, 3);
           canvas.set(x, y, clamp01((positive_mod(x + y, N) / w) % 2 ? base * (0.9f + 0.2f * n) : accent * (0.9f + 0.2f * n)));
+        }
+      break;
+    }
+    case TextureKind::Grate: {
+      // 8 x 8 square holes per tile; bars a quarter of the pitch wide, slightly rusty.
+      const int pitch = N / 8, bar = std::max(1, pitch / 4);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          const bool on = (x % pitch) < bar || (y % pitch) < bar;
+          const float n = noise(x, y, 3);
+          canvas.set(x, y, clamp01(lerp(base, accent, 0.6f * n)), on ? 1.0f : 0.0f);
+        }
+      break;
+    }
+    case TextureKind::Grid: {
+      const int pitch = std::max(2, N / 16);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          const bool on = (x % pitch) < line || (y % pitch) < line;
+          const float n = noise(x, y, 2);
+          canvas.set(x, y, clamp01(on ? accent : base * (0.9f + 0.2f * n)));
+        }
+      break;
+    }
+    case TextureKind::Tread: {
+      // Raised diamonds in alternating orientation, 8 per row, lit from the top left.
+      const int pitch = N / 8;
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          const int cx = x / pitch, cy = y / pitch;
+          const float u = (x % pitch + 0.5f) / pitch - 0.5f, v = (y % pitch + 0.5f) / pitch - 0.5f;
+          // A thin diamond along one diagonal (the other in alternate cells).
+          const float a = (cx + cy) % 2 ? u + v : u - v, b = (cx + cy) % 2 ? u - v : u + v;
+          const bool raised = std::abs(a) < 0.32f && std::abs(b) < 0.08f;
+          const float light = raised ? (b > 0 ? 1.3f : 0.75f) : 1.0f;
+          const float n = tileable_noise(x + 0.5f, y + 0.5f, N, 5, seed);
+          canvas.set(x, y, clamp01(lerp(base, accent, 0.25f * n) * light));
+        }
+      break;
+    }
+    case TextureKind::Hexes: {
+      // Pointy hexagons on a lattice that tiles the texture: 4 columns, 4 double rows.
+      const float w = static_cast<float>(N) / 4, h = static_cast<float>(N) / 4;  // cell pitch x, double-row pitch y
+      const float r = w / std::sqrt(3.0f);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          // Nearest hexagon centre among the candidates of both row offsets (periodic in N).
+          float best = 1e9f, second = 1e9f;
+          int id = 0;
+          for (int row = -1; row <= 8; ++row)
+            for (int col = -1; col <= 4; ++col) {
+              const float cx = (col + 0.5f * (row % 2 != 0)) * w, cy = row * h / 2;
+              const float d = std::hypot(x + 0.5f - cx, y + 0.5f - cy);
+              if (d < best) second = best, best = d, id = positive_mod(col, 4) * 16 + positive_mod(row, 8);
+              else if (d < second) second = d;
+            }
+          const bool grout = second - best < std::max(1.0f, r * 0.08f);
+          const float shade = 0.8f + 0.35f * hash01(id, 3, seed);
+          canvas.set(x, y, clamp01(grout ? accent * 0.6f : base * shade));
         }
       break;
     }

@@ -20,7 +20,15 @@ enum class TextureKind {
   ChainLink,  // RGBA diamond wire mesh with transparent holes (fences; alpha-tested)
   Plates,     // metal plates with seams and rivets
   Stripes,    // diagonal hazard stripes
+  // Families added for procedural variety (kept after the first nine: their names index materials).
+  Grate,      // RGBA floor/wall grate: a grid of bars with square holes (alpha-tested)
+  Grid,       // fine grid lines on a plain panel (high frequency: 16 cells per tile)
+  Tread,      // metal tread plate: rows of raised diamonds, high frequency
+  Hexes,      // hexagonal tiles with grout lines
 };
+
+// Kinds whose texture has an alpha channel of holes (a material needs an alpha cutoff).
+bool texture_kind_has_holes(TextureKind kind);
 
 const std::vector<std::string>& texture_kind_names();
 TextureKind texture_kind_from_name(const std::string& name);  // cgsr::Error listing valid names

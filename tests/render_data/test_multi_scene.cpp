@@ -188,6 +188,25 @@ TEST(MultiSceneRender, SceneSetConfigWithWeightsAndFrames) {
   EXPECT_NE(again.all().find("rendered 0 frame(s) (14 resumed)"), std::string::npos) << again.all();
 }
 
+TEST(MultiSceneRender, EntriesOverrideTheirConfig) {
+  const Renders& r = renders();
+  const fs::path config = r.root / "variants.yaml";
+  std::ofstream(config) << "scenes:\n  - {config: " << tiny_config() << ", name: a, frames: 2, set: [scene.variant=1]}\n"
+                        << "  - {config: " << tiny_config() << ", name: b, frames: 2, set: [scene.variant=2]}\n";
+  const fs::path out = r.root / "variants";
+  const CliResult run = run_cgsr("render --config " + config.string() + " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.all();
+  // One config, two levels: the scenes' first frames differ.
+  EXPECT_NE(read_text(out / "scenes" / "a" / "128x96" / "color" / "000000.png"),
+            read_text(out / "scenes" / "b" / "128x96" / "color" / "000000.png"));
+  const fs::path bad = r.root / "bad_override.yaml";
+  std::ofstream(bad) << "scenes:\n  - {config: " << tiny_config() << ", set: [scene.layuot=hall]}\n";
+  const CliResult error = run_cgsr("render --config " + bad.string() + " --out " + (r.root / "bad").string());
+  EXPECT_EQ(error.exit_code, 2) << error.all();
+  EXPECT_NE(error.all().find("set scene.layuot=hall"), std::string::npos) << error.all();
+  EXPECT_NE(error.all().find("did you mean 'layout'"), std::string::npos) << error.all();
+}
+
 // Frames drawn by batches 0 .. batches-1, counted per scene.
 std::map<std::string, int> draws_per_scene(const Dataset& data, uint64_t seed, int batches) {
   PatchSamplerOptions o;

@@ -1,13 +1,19 @@
 // The procedural scene source: determinism, every shipped scene config, a camera that never
-// passes through geometry, and tileable textures.
+// passes through geometry, tileable textures, and variety drawn from the seed.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <set>
 
 #include "core/config.h"
 #include "core/error.h"
+#include "core/text.h"
 #include "render_data/procedural/procedural_scene.h"
 #include "render_data/procedural/procedural_textures.h"
+#include "render_data/procedural/procedural_variety.h"
+#include "test_scenes.h"
 #include "render_data/render_job.h"
 #include "render_data/scene_source.h"
 
@@ -72,7 +78,11 @@ void expect_camera_in_free_space(const SceneBundle& b, const std::string& what) 
   for (int f = 0; f < 120; ++f) {
     const Vec3 p = b.camera.at_frame(f, 120).position;
     for (const auto& mesh : b.scene.meshes) {
-      if (mesh.name == "floor" || mesh.name == "ceiling" || mesh.name == "walls" || mesh.name == "wire") continue;
+      // Walls, floor, ceiling: the walk avoids wall cells; cables hang overhead; the skyline stands
+      // outside the level (one mesh around it).
+      if (mesh.name == "floor" || mesh.name == "ceiling" || mesh.name == "walls" || mesh.name == "wire" ||
+          mesh.name == "skyline")
+        continue;
       Vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
       for (const auto& v : mesh.positions) lo = min(lo, v), hi = max(hi, v);
       const bool inside = p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y && p.z > lo.z && p.z < hi.z;
@@ -141,6 +151,132 @@ TEST(ProceduralTextures, EveryKindTilesSeamlessly) {
   EXPECT_GT(holes, wire);  // mostly see-through
   EXPECT_GT(wire, 64 * 4);
   EXPECT_THROW(texture_kind_from_name("brick"), Error);
+}
+
+// ---- variety ----------------------------------------------------------------------------------
+
+const std::string kVariety = "type: procedural\nlayout: random\ntexture_size: 32\nvariety: {size: [7, 10]}\n";
+
+// Everything a renderer reads from a scene, compared exactly.
+void expect_identical(const SceneBundle& a, const SceneBundle& b) {
+  ASSERT_EQ(a.scene.meshes.size(), b.scene.meshes.size());
+  for (size_t m = 0; m < a.scene.meshes.size(); ++m) {
+    const Mesh &x = a.scene.meshes[m], &y = b.scene.meshes[m];
+    ASSERT_EQ(x.positions.size(), y.positions.size()) << x.name;
+    EXPECT_EQ(0, std::memcmp(x.positions.data(), y.positions.data(), x.positions.size() * sizeof(Vec3))) << x.name;
+    EXPECT_EQ(x.indices, y.indices);
+    EXPECT_EQ(x.material, y.material);
+  }
+  ASSERT_EQ(a.scene.textures.size(), b.scene.textures.size());
+  for (size_t t = 0; t < a.scene.textures.size(); ++t) EXPECT_EQ(a.scene.textures[t].data, b.scene.textures[t].data);
+  ASSERT_EQ(a.scene.lights.size(), b.scene.lights.size());
+  for (size_t l = 0; l < a.scene.lights.size(); ++l) EXPECT_EQ(a.scene.lights[l].color.x, b.scene.lights[l].color.x);
+  EXPECT_EQ(a.scene.fog.density, b.scene.fog.density);
+  EXPECT_EQ(a.scene.sky.zenith.z, b.scene.sky.zenith.z);
+  ASSERT_EQ(a.camera.keys.size(), b.camera.keys.size());
+  for (size_t k = 0; k < a.camera.keys.size(); ++k) EXPECT_EQ(a.camera.keys[k].pose.yaw, b.camera.keys[k].pose.yaw);
+}
+
+// The texture family of every material ("bricks3" -> "bricks").
+std::set<std::string> families(const Scene& scene) {
+  std::set<std::string> out;
+  for (const auto& m : scene.materials)
+    if (m.albedo_texture >= 0) out.insert(m.name.substr(0, m.name.find_first_of("0123456789")));
+  return out;
+}
+
+TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
+  expect_identical(build(kVariety, 11), build(kVariety, 11));
+  expect_identical(build(kVariety + "variant: 4\n", 11), build(kVariety + "variant: 4\n", 11));
+  // Over 40 seeds every layout, dark and bright, fog on and off; over a dozen, many texture families.
+  ProceduralOptions options;
+  options.layout = "random";
+  options.variety.enabled = true;
+  std::set<std::string> layouts, all_families;
+  float darkest = 1e9f, brightest = 0;
+  int foggy = 0;
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    const ProceduralOptions drawn = draw_variety(options, seed);
+    layouts.insert(drawn.layout);
+    darkest = std::min(darkest, drawn.lighting.ambient);
+    brightest = std::max(brightest, drawn.lighting.ambient);
+    foggy += drawn.fog.density > 0;
+    if (seed <= 12)
+      for (const auto& f : families(build(kVariety, seed).scene)) all_families.insert(f);
+  }
+  EXPECT_EQ(layouts.size(), 5u) << join(std::vector<std::string>(layouts.begin(), layouts.end()));
+  EXPECT_GE(all_families.size(), 8u) << join(std::vector<std::string>(all_families.begin(), all_families.end()));
+  EXPECT_GT(brightest, 3 * darkest);
+  EXPECT_GT(foggy, 0);
+  EXPECT_LT(foggy, 40);
+  // A variant is another level of the same seed; variant 0 is the seed's own level.
+  const auto base = build(kVariety, 11), other = build(kVariety + "variant: 1\n", 11);
+  EXPECT_TRUE(base.scene.meshes.size() != other.scene.meshes.size() ||
+              base.scene.textures[0].data != other.scene.textures[0].data);
+  expect_identical(base, build(kVariety + "variant: 0\n", 11));
+}
+
+TEST(ProceduralVariety, SameSeedRendersBitIdenticalFrames) {
+  const fs::path root = test::temp_dir("variety_frames");
+  std::vector<std::string> colour;
+  for (const char* run : {"a", "b"}) {
+    RenderJobOptions job;
+    job.frames = 2;
+    job.resolutions = {"32x24", "64x48"};
+    job.shadow_map_size = 64;
+    const auto doc = config::Document::parse(kVariety, "variety.yaml");
+    job.scene = config::Block{doc.root(), std::make_shared<config::Document>(doc), "scene"};
+    run_render_job(job, 3, root / run);
+    std::ifstream in(root / run / "64x48" / "color" / "000001.png", std::ios::binary);
+    colour.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_GT(colour[0].size(), 100u);
+  EXPECT_EQ(colour[0], colour[1]);
+}
+
+TEST(ProceduralVariety, EveryLayoutHasAWalkableCameraPath) {
+  for (const std::string layout : {"room", "corridors", "hall", "arena", "outdoor"})
+    for (uint64_t seed : {1, 2, 3}) {
+      SCOPED_TRACE(layout + " seed " + std::to_string(seed));
+      const auto b = build("type: procedural\nlayout: " + layout + "\ntexture_size: 32\nvariety: {size: [6, 12]}\n", seed);
+      ASSERT_GE(b.camera.keys.size(), 2u);
+      EXPECT_GT(length(b.camera.keys.back().pose.position - b.camera.keys.front().pose.position) +
+                    length(b.camera.keys[1].pose.position - b.camera.keys[0].pose.position),
+                0.5f);
+      expect_camera_in_free_space(b, layout);
+      bool ceiling = false, columns = false, skyline = false;
+      for (const auto& m : b.scene.meshes) {
+        ceiling |= m.name == "ceiling";
+        columns |= m.name == "column";
+        skyline |= m.name == "skyline";
+      }
+      EXPECT_EQ(ceiling, layout != "arena" && layout != "outdoor");
+      EXPECT_EQ(skyline, layout == "outdoor");
+      if (layout == "hall") EXPECT_TRUE(columns);
+    }
+  // Without variety, the new layouts build too (fixed materials).
+  expect_camera_in_free_space(build("type: procedural\nlayout: hall\nsize: [10, 9]\nheight: 8\ntexture_size: 32\n", 2), "hall");
+  expect_camera_in_free_space(build("type: procedural\nlayout: outdoor\nsize: [10, 9]\ntexture_size: 32\n", 2), "outdoor");
+}
+
+TEST(ProceduralVariety, BadRangesAreErrorsNamingTheKey) {
+  auto message = [](const std::string& variety) {
+    try {
+      build("type: procedural\nlayout: random\nvariety: " + variety + "\n", 1);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("{size: [12, 6]}").find("variety.size: must be [lo, hi] with lo <= hi"), std::string::npos)
+      << message("{size: [12, 6]}");
+  EXPECT_NE(message("{size: [2, 6]}").find("variety.size: must be in [5, 60]"), std::string::npos);
+  EXPECT_NE(message("{materials: [grate]}").find("needs at least one family without holes"), std::string::npos);
+  EXPECT_NE(message("{materials: [brick]}").find("did you mean 'bricks'"), std::string::npos);
+  EXPECT_NE(message("{layouts: []}").find("needs at least one layout"), std::string::npos);
+  EXPECT_NE(message("{layouts: [maze]}").find("one of: room, corridors, hall, arena, outdoor"), std::string::npos);
+  EXPECT_NE(message("{brightness: [0, 2]}").find("variety.brightness"), std::string::npos);
+  EXPECT_NE(message("{fog: 2}").find("variety.fog"), std::string::npos);
 }
 
 }  // namespace

@@ -30,5 +30,19 @@ TEST(Visualize, AChannelOneResolutionLacksLeavesItsCellBlack) {
   EXPECT_THROW(montage(lr, hr, {PreviewChannel::Normal}), Error);  // neither has it
 }
 
+TEST(Visualize, TilesFramesRowByRowWithWhiteGaps) {
+  std::vector<Frame> frames{colour_frame(4, 3), colour_frame(4, 3), colour_frame(4, 3)};
+  frames[2].color.fill_(0);
+  const auto grid = tile_frames(frames, PreviewChannel::Color, 2);
+  ASSERT_EQ(grid.sizes(), (std::vector<int64_t>{3, 2 * 3 + 4, 2 * 4 + 4}));
+  EXPECT_NEAR(grid[0][0][0].item<float>(), 200 / 255.0f, 1e-6);   // frame 0, top left
+  EXPECT_EQ(grid[0][3][0].item<float>(), 1.0f);                   // the gap between rows
+  EXPECT_EQ(grid.slice(1, 7).slice(2, 0, 4).max().item<float>(), 0.0f);  // frame 2 starts row 2
+  EXPECT_EQ(grid.slice(1, 7).slice(2, 8).min().item<float>(), 1.0f);     // no fourth frame: white
+  frames.push_back(colour_frame(8, 6));
+  EXPECT_THROW(tile_frames(frames, PreviewChannel::Color, 2), Error);    // sizes differ
+  EXPECT_THROW(tile_frames(frames, PreviewChannel::Depth, 2), Error);    // no depth
+}
+
 }  // namespace
 }  // namespace cgsr
