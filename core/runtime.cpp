@@ -1,6 +1,9 @@
 #include "core/runtime.h"
 
+#include <ATen/Parallel.h>
+#include <omp.h>
 #include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/task_scheduler_observer.h>
 
 #include <memory>
 #include <thread>
@@ -21,6 +24,23 @@ int& threads_storage() {
   static int threads = 0;
   return threads;
 }
+// LibTorch ops run on a TBB worker (frame decoding, batch building) would otherwise start an
+// OpenMP team of the process-wide size on that thread. libgomp, then managing more threads than
+// there are cores, lets every OpenMP worker (the training step's too) sleep at once between
+// parallel regions: the train stage ran its compute 2.3x slower than the same step alone. TBB
+// workers are already parallel across tasks, so their torch ops run on their own thread.
+class OneOpenMpThreadPerTbbWorker : public tbb::task_scheduler_observer {
+ public:
+  OneOpenMpThreadPerTbbWorker() { observe(true); }
+  void on_scheduler_entry(bool is_worker) override {
+    if (!is_worker) return;
+    // LibTorch sets a thread's team size on its first parallel op; that happens here first so
+    // that the size set after it (per thread, in OpenMP) stays.
+    at::internal::lazy_init_num_threads();
+    omp_set_num_threads(1);
+  }
+};
+
 // SplitMix64: decorrelates seeds derived from nearby integers.
 uint64_t mix(uint64_t x) {
   x += 0x9E3779B97F4A7C15ULL;
@@ -36,6 +56,7 @@ int set_threads(int threads) {
   tbb_limit() = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                       static_cast<size_t>(threads));
   threads_storage() = threads;
+  static OneOpenMpThreadPerTbbWorker observer;
   return threads;
 }
 

@@ -7,7 +7,8 @@
 namespace cgsr {
 
 // Sets LibTorch intra-op threads and the TBB arena width together; 0 = all hardware threads.
-// Returns the number in effect.
+// Torch ops on TBB worker threads run single-threaded from then on (the tasks are the
+// parallelism; nested OpenMP teams would oversubscribe the cores). Returns the number in effect.
 int set_threads(int threads);
 int thread_count();
 
