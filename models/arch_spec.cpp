@@ -64,6 +64,10 @@ const std::vector<std::string>& EnumNames<RitFusion>::names() {
   static const std::vector<std::string> names = {"concat", "add"};
   return names;
 }
+const std::vector<std::string>& EnumNames<ImageSkip>::names() {
+  static const std::vector<std::string> names = {"bilinear", "bicubic"};
+  return names;
+}
 const std::vector<std::string>& EnumNames<Colors>::names() {
   static const std::vector<std::string> names = {"rgb", "y"};
   return names;
@@ -121,6 +125,8 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   }
   if (spec.colors == Colors::Y && !info.supports_y)
     problems.push_back({"colors", spec.backbone + " works on RGB only (colors: y is for srcnn)"});
+  if (spec.image_skip != ImageSkip::Bilinear && !info.has_image_skip)
+    problems.push_back({"image_skip", spec.backbone + " adds no interpolated image to its output (image_skip is for pan)"});
   if (spec.blocks >= 0 && (spec.blocks < info.min_blocks || spec.blocks > info.max_blocks))
     problems.push_back({"blocks", info.max_blocks == 0
                                       ? spec.backbone + " has no residual blocks; blocks must be 0"
@@ -248,6 +254,9 @@ config::Schema<ArchSpec> arch_spec_schema() {
   s.field("scale", &ArchSpec::scale, "upscaling factor").range(2, 4);
   s.field("colors", &ArchSpec::colors, "colour channels the network works on");
   s.field("blocks", &ArchSpec::blocks, "number of residual blocks (default: the backbone's)");
+  s.field("image_skip", &ArchSpec::image_skip, "interpolation of the LR image added to the output (pan)");
+  // Written only when not the default, so specs and stage hashes from before the option read the same.
+  s.omit_when("image_skip", [](const ArchSpec& spec) { return spec.image_skip == ImageSkip::Bilinear; });
   s.field("widths", &ArchSpec::widths, "width of each prunable layer group (default: the backbone's)");
   s.section("rit", &ArchSpec::rit, rit_spec_schema(), "rendering information transform block");
   s.section("geometry", &ArchSpec::geometry, geometry_spec_schema(), "geometry head (training only)");
@@ -287,6 +296,7 @@ void save_spec_file(const std::filesystem::path& path, const ArchSpec& spec) {
 std::string spec_summary(const ArchSpec& spec) {
   std::string s = spec.backbone + " x" + std::to_string(spec.scale);
   if (spec.colors == Colors::Y) s += " (Y)";
+  if (spec.image_skip != ImageSkip::Bilinear) s += " (" + enum_name(spec.image_skip) + " skip)";
   if (spec.rit.enabled) {
     const auto& r = spec.rit;
     std::string widths;

@@ -7,6 +7,8 @@
 //   scale: 2                 # 2, 3 or 4
 //   colors: rgb              # rgb, or y (SRCNN only: the network sees BT.601 luma)
 //   blocks: 16               # residual blocks (PAN, EDSR); 0 for SRCNN
+//   image_skip: bilinear     # PAN: the interpolation of the LR image added to the output
+//                            #   (bilinear, PAN's own; bicubic leaves the network less to learn)
 //   widths:                  # width of every prunable layer group, by name
 //     features: 40
 //     block0_a: 20
@@ -83,6 +85,14 @@ struct EnumNames<Colors> {
   static const std::vector<std::string>& names();
 };
 
+// The interpolation of the LR image a backbone adds to its output (PAN): bilinear or bicubic.
+enum class ImageSkip { Bilinear, Bicubic };
+template <>
+struct EnumNames<ImageSkip> {
+  static constexpr const char* kind = "image skip";
+  static const std::vector<std::string>& names();
+};
+
 struct RitSpec {
   bool enabled = false;
   std::vector<std::string> channels = {"depth", "normal", "normal_angle", "edge"};  // render_channels.h names
@@ -122,6 +132,7 @@ struct ArchSpec {
   int scale = 2;
   Colors colors = Colors::Rgb;
   int blocks = -1;             // -1 until resolved: the backbone's default
+  ImageSkip image_skip = ImageSkip::Bilinear;  // backbones with an image skip (BackboneInfo)
   GroupWidths widths;
   RitSpec rit;
   GeometrySpec geometry;
@@ -135,7 +146,7 @@ struct ArchSpec {
 
   bool operator==(const ArchSpec& o) const {
     return backbone == o.backbone && scale == o.scale && colors == o.colors && blocks == o.blocks &&
-           widths == o.widths && rit == o.rit && geometry == o.geometry;
+           image_skip == o.image_skip && widths == o.widths && rit == o.rit && geometry == o.geometry;
   }
   bool operator!=(const ArchSpec& o) const { return !(*this == o); }
 };

@@ -26,6 +26,7 @@ struct BackboneInfo {
   int min_blocks = 0;
   int max_blocks = 0;
   bool supports_y = false;  // may run on BT.601 luma (colors: y)
+  bool has_image_skip = false;  // adds the interpolated LR image to its output (image_skip)
   // Per-block groups are named "block<i>_<suffix>"; the suffixes, for error messages.
   std::vector<std::string> block_group_suffixes;
   // Every layer group of a network with this scale and block count, in canonical order.

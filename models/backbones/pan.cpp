@@ -35,6 +35,7 @@ BackboneInfo pan_info() {
   info.default_blocks = 16;
   info.min_blocks = 1;
   info.max_blocks = 64;
+  info.has_image_skip = true;
   info.block_group_suffixes = block_suffixes();
   info.groups = pan_groups;
   info.build = [](const ArchSpec& spec) -> std::shared_ptr<BackboneImpl> { return std::make_shared<PanImpl>(spec); };
@@ -108,7 +109,9 @@ int ScpaBlockImpl::describe(graph::Builder& g, int x) const {
 
 // ---- PAN ---------------------------------------------------------------------------------------
 
-PanImpl::PanImpl(const ArchSpec& spec) : scale_(spec.scale) {
+PanImpl::PanImpl(const ArchSpec& spec)
+    : scale_(spec.scale),
+      skip_mode_(spec.image_skip == ImageSkip::Bicubic ? graph::ResizeMode::Bicubic : graph::ResizeMode::Bilinear) {
   stages_ = spec.scale == 4 ? 2 : 1;
   stage_factor_ = spec.scale == 4 ? 2 : spec.scale;
   const int64_t nf = spec.group_width("features");
@@ -158,7 +161,7 @@ Reconstruction PanImpl::reconstruct(const torch::Tensor& features, const torch::
     if (at_hr) fea = at_hr(fea);
     fea = lrelu(hr_conv2(fea));
   }
-  const auto out = conv_last(fea).add_(graph::apply_resize(skip, scale_, graph::ResizeMode::Bilinear));
+  const auto out = conv_last(fea).add_(graph::apply_resize(skip, scale_, skip_mode_));
   return {out, fea};
 }
 
@@ -189,7 +192,7 @@ ReconstructionPorts PanImpl::describe_reconstruct(graph::Builder& g, int feature
   int fea = stage(features, "upconv1", upconv1, "att1", att1, "hr_conv1", hr_conv1, "up1", "hr1", stages_ == 1);
   if (stages_ == 2) fea = stage(fea, "upconv2", upconv2, "att2", att2, "hr_conv2", hr_conv2, "up2", "hr2", true);
   const int out = describe_conv(g, "conv_last", conv_last, fea, graph::fixed_layout("rgb", 3));
-  const int ilr = g.resize(skip, scale_, graph::ResizeMode::Bilinear);
+  const int ilr = g.resize(skip, scale_, skip_mode_);
   return {g.add(out, ilr), fea};
 }
 

@@ -79,6 +79,7 @@ class PanImpl : public BackboneImpl {
 
  private:
   int scale_;
+  graph::ResizeMode skip_mode_;  // the interpolation of the LR image added to the output
   int stages_;          // upsampling stages: 1 (x2, x3) or 2 (x4)
   int64_t stage_factor_;  // nearest factor per stage
   torch::nn::Conv2d conv_first{nullptr}, trunk_conv{nullptr}, conv_last{nullptr};

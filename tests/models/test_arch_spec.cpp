@@ -116,6 +116,19 @@ TEST(ArchSpec, InconsistentCombinationsAreErrors) {
   EXPECT_NE(parse_error("backbone: pan\nrit: {enabled: true, channels: []}\n").find("at least one"),
             std::string::npos);
   EXPECT_NE(parse_error("backbone: edsr\nblocks: 0\n").find("blocks must be in [1, 64]"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: edsr\nimage_skip: bicubic\n").find("image_skip is for pan"), std::string::npos);
+  EXPECT_NE(parse_error("backbone: pan\nimage_skip: bicubc\n").find("did you mean 'bicubic'"), std::string::npos);
+}
+
+// The option is written only when set, so specs (and stage hashes) from before it read the same.
+TEST(ArchSpec, ImageSkipRoundTripsAndIsOmittedAtItsDefault) {
+  ArchSpec s = default_spec("pan", 2);
+  EXPECT_EQ(spec_to_yaml(s).find("image_skip"), std::string::npos);
+  s.image_skip = ImageSkip::Bicubic;
+  const std::string yaml = spec_to_yaml(s);
+  EXPECT_NE(yaml.find("image_skip: bicubic"), std::string::npos) << yaml;
+  EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
+  EXPECT_NE(spec_summary(s).find("bicubic skip"), std::string::npos);
 }
 
 TEST(ArchSpec, ProgrammaticSpecsAreValidatedToo) {

@@ -136,6 +136,19 @@ TEST_F(FusedGraphTest, EveryBackboneAtEveryScale) {
     }
 }
 
+// A bicubic image skip runs as a LibTorch step inside the plan (oneDNN resamples nearest and
+// linear only).
+TEST_F(FusedGraphTest, BicubicImageSkip) {
+  uint64_t seed = 30;
+  for (int scale : {2, 3, 4}) {
+    SCOPED_TRACE("x" + std::to_string(scale));
+    ArchSpec spec = default_spec("pan", scale);
+    spec.image_skip = ImageSkip::Bicubic;
+    expect_network_matches(spec, ++seed);
+    expect_network_matches(with_rit(spec, "hr_unshuffle+hr_fuse", "concat"), ++seed);
+  }
+}
+
 TEST_F(FusedGraphTest, RitVariants) {
   uint64_t seed = 40;
   for (const char* b : {"pan", "edsr", "srcnn"})
