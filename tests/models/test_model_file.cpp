@@ -199,11 +199,11 @@ const fs::path kVersion1File = fs::path(CGSR_SOURCE_DIR) / "tests/data/model_fil
 TEST(ModelFile, FilesFromBeforeDepthEncodingsReadZBufferDepth) {
   const auto dir = scratch_dir("model-file-legacy");
   SRNetwork net = build_network(with_rit(default_spec("pan", 2)), 11);
-  EXPECT_EQ(net->spec().rit.depth_encoding, "log");  // what new networks read
+  EXPECT_EQ(net->spec().rit.depth_encoding, DepthEncoding::Log);  // what new networks read
   save_model(dir / "old.cgsr", *net);
   drop_depth_encoding(dir / "old.cgsr");
   Model old = load_model(dir / "old.cgsr");
-  EXPECT_EQ(old.network->spec().rit.depth_encoding, "zbuffer");
+  EXPECT_EQ(old.network->spec().rit.depth_encoding, DepthEncoding::ZBuffer);
   EXPECT_EQ(old.network->depth_encoding(), DepthEncoding::ZBuffer);
   // Same weights, same function: only the input contract differs.
   const auto [color, info] = random_inputs(net->spec(), 6, 5);
