@@ -46,7 +46,7 @@ struct TrainSchedule {
   int val_frames = 8;           // validation frames (spread over the split); 0 = all
   int checkpoint_every = 100;   // steps
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
-  std::string layout = "auto";  // activation memory layout: auto (measured) | nchw | nhwc
+  MemoryLayout layout = MemoryLayout::Auto;  // activation memory layout: auto (measured), nchw or nhwc
   int prefetch = 2;             // batches built ahead on other threads (0: between steps)
 };
 config::Schema<TrainSchedule> schedule_schema();
@@ -73,7 +73,7 @@ struct TrainOutcome {
   std::vector<ValidationScore> history;
   std::vector<double> loss_curve;  // training loss (the CGSR total) of every step, over the global batch
   bool resumed = false;
-  std::string layout;  // the memory layout the steps ran in
+  MemoryLayout layout = MemoryLayout::Nchw;  // the memory layout the steps ran in
   StepPhases phase_ms;  // over the steps this run took (a resumed run: since the resume)
 };
 nlohmann::ordered_json to_json(const TrainOutcome& outcome);

@@ -136,7 +136,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
                             "\n" + config::to_yaml(candidate_training_schema().emit(options.candidate));
     world = join_run(options.distributed, job);
     queue.emplace(*world);
-    if (options.candidate.schedule.layout == "auto")
+    if (options.candidate.schedule.layout == MemoryLayout::Auto)
       spdlog::warn("candidate.schedule.layout is auto: each process measures its own memory layout, so a score can "
                    "differ in the last digits from a 1-process run (set nchw or nhwc for identical ones)");
     if (!world->coordinator()) {
