@@ -67,10 +67,7 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
   j["patches_per_second"] = o.patches_per_second;
   j["resumed"] = o.resumed;
   j["layout"] = enum_name(o.layout);
-  const StepPhases& p = o.phase_ms;
-  j["phase_ms"] = {{"batch", p.batch},         {"forward_and_loss", p.forward_and_loss},
-                   {"backward_and_clip", p.backward_and_clip}, {"optimizer", p.optimizer},
-                   {"validation", p.validation}, {"checkpoint", p.checkpoint}};
+  j["phase_ms"] = o.phase_ms;
   j["best"] = score(o.best);
   j["last"] = score(o.last);
   j["history"] = nlohmann::ordered_json::array();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "core/json_fields.h"
 #include "models/memory_layout.h"
 #include "models/model_file.h"
 #include "models/sr_network.h"
@@ -63,6 +64,7 @@ struct ValidationScore {
 struct StepPhases {
   double batch = 0, forward_and_loss = 0, backward_and_clip = 0, optimizer = 0, validation = 0, checkpoint = 0;
 };
+CGSR_JSON_FIELDS(StepPhases, batch, forward_and_loss, backward_and_clip, optimizer, validation, checkpoint)
 
 struct TrainOutcome {
   int steps = 0;

@@ -186,10 +186,10 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   nlohmann::ordered_json j;
   j["name"] = name;
   j["model"] = run_dir.file("model.cgsr").string();
-  j["parent"] = {{"spec", spec_summary(result.parent.spec)}, {"score", to_json(result.parent.score)}};
+  j["parent"] = {{"spec", spec_summary(result.parent.spec)}, {"score", result.parent.score}};
   j["pick"] = {{"spec", spec_summary(result.pick.spec)},
                {"spec_yaml", spec_to_yaml(result.pick.spec)},
-               {"score", to_json(result.pick.score)},
+               {"score", result.pick.score},
                {"is_parent", result.pick_is_parent}};
   j["param_reduction"] = reduction;
   j["pareto_front"] = nlohmann::ordered_json::array();

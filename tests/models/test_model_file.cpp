@@ -368,3 +368,23 @@ TEST(ModelFile, ASpecFarLargerThanItsWeightsIsRefusedBeforeBuilding) {
   EXPECT_NE(what.find(path.string() + ": the spec describes a network of more than"), std::string::npos) << what;
   fs::remove_all(dir);
 }
+
+// The provenance object of a model file's metadata: its keys in order, and missing keys (older
+// files) read as their defaults.
+TEST(ModelFile, ProvenanceJsonKeepsItsKeysAndReadsMissingOnesAsDefaults) {
+  Provenance p;
+  p.stage = "pruned";
+  p.parent = "search/model.cgsr";
+  p.metrics = {{"psnr", 30.5}};
+  EXPECT_EQ(nlohmann::ordered_json(p).dump(),
+            R"({"stage":"pruned","parent":"search/model.cgsr","config":{},"metrics":{"psnr":30.5},"extra":{}})");
+  const Provenance back = provenance_from_json(nlohmann::ordered_json(p), "m.cgsr");
+  EXPECT_EQ(back.stage, p.stage);
+  EXPECT_EQ(back.metrics, p.metrics);
+  const Provenance old = provenance_from_json(nlohmann::ordered_json::parse(R"({"stage":"backbone"})"), "m.cgsr");
+  EXPECT_EQ(old.stage, "backbone");
+  EXPECT_EQ(old.parent, "");
+  EXPECT_TRUE(old.config.is_object() && old.config.empty());
+  EXPECT_THROW(provenance_from_json(nlohmann::ordered_json::parse(R"({"stage":3})"), "m.cgsr"), Error);
+  EXPECT_THROW(provenance_from_json(nlohmann::ordered_json::array(), "m.cgsr"), Error);
+}

@@ -250,3 +250,12 @@ TEST(Trainer, ConsecutiveNonFiniteStepsStopTrainingWithAClearError) {
     EXPECT_NE(what.find("lr_max"), std::string::npos) << what;
   }
 }
+
+// A train stage's results.json records where the step time went under phase_ms, in this order.
+TEST(Trainer, PhaseTimesKeepTheirJsonFormat) {
+  TrainOutcome o;
+  o.phase_ms = {1.5, 2.5, 3.5, 0.25, 0, 0.125};
+  EXPECT_EQ(to_json(o)["phase_ms"].dump(), R"({"batch":1.5,"forward_and_loss":2.5,"backward_and_clip":3.5,)"
+                                           R"("optimizer":0.25,"validation":0.0,"checkpoint":0.125})");
+  EXPECT_EQ(to_json(o)["layout"], "nchw");
+}
