@@ -21,8 +21,9 @@ config::Schema<SearchCommandOptions> search_command_schema() {
   s.field("parent", &SearchCommandOptions::parent, "CG-enhanced model file to start from").required();
   s.field("data", &SearchCommandOptions::data, "data set directory").required();
   s.inline_section(&SearchCommandOptions::search, search_schema());
-  s.moved_block("search");  // configs before the search options moved up: `search: {strategy: ...}`
-  s.upgrade(move_operators_into_strategy);  // lifted from `search:` or at the top
+  // Configs before the search options moved up: `search: {strategy: ...}`; the inlined options'
+  // upgrade (a former `operators:` block) then reads it whether lifted from there or at the top.
+  s.moved_block("search");
   s.section("candidate", &SearchCommandOptions::candidate, candidate_training_schema(), "training of each candidate");
   s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
   s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
