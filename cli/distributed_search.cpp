@@ -12,7 +12,7 @@ distributed::WorkQueue::Runner candidate_runner(Evaluator& local) {
   return [&local](size_t index, const std::string& task) {
     const ArchSpec spec = spec_from_yaml(task, "distributed candidate " + std::to_string(index));
     spdlog::info("distributed: training candidate {} {}", index, spec_summary(spec));
-    return to_json(local.evaluate(spec)).dump();
+    return nlohmann::ordered_json(local.evaluate(spec)).dump();
   };
 }
 }  // namespace
@@ -23,7 +23,7 @@ void DistributedEvaluator::evaluate_batch(const std::vector<ArchSpec>& specs,
   std::vector<std::string> tasks;
   for (const auto& spec : specs) tasks.push_back(spec_to_yaml(spec));
   queue_.run_batch(tasks, candidate_runner(local_), [&](size_t index, const std::string& result) {
-    done(index, candidate_score_from_json(nlohmann::json::parse(result)));
+    done(index, nlohmann::json::parse(result).get<CandidateScore>());
   });
 }
 

@@ -174,8 +174,7 @@ std::string Verdict::text() const {
 nlohmann::ordered_json Verdict::to_json() const {
   nlohmann::ordered_json j;
   j["passed"] = passed();
-  j["checks"] = nlohmann::ordered_json::array();
-  for (const auto& c : checks) j["checks"].push_back({{"claim", c.claim}, {"passed", c.passed}, {"detail", c.detail}});
+  j["checks"] = nlohmann::ordered_json(checks);
   return j;
 }
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "core/json_fields.h"
 #include "train/evaluation.h"
 
 namespace cgsr::cli {
@@ -65,6 +66,7 @@ struct VerdictCheck {
   bool passed = false;
   std::string detail;  // the figures behind it
 };
+CGSR_JSON_FIELDS(VerdictCheck, claim, passed, detail)
 
 struct Verdict {
   std::vector<VerdictCheck> checks;

@@ -292,7 +292,10 @@ class Schema {
   }
 
   // The keys of `sub` read and written at this level, stored in `member`: a block of options
-  // that would otherwise repeat its owner's name (`cgsr search`'s search options).
+  // that would otherwise repeat its owner's name (`cgsr search`'s search options). The keys sit
+  // at this level, so `sub`'s older shapes do too: its moved blocks are lifted and its upgrades
+  // rewrite this level's map (after this schema's own moved blocks are lifted, before its
+  // fields are read), with the deprecation warnings they give.
   template <class S>
   void inline_section(S T::*member, const Schema<S>& sub) {
     for (const auto& inner : sub.fields_) {
@@ -312,6 +315,8 @@ class Schema {
     for (const auto& check : sub.cross_checks_)
       cross_checks_.push_back(
           [member, check](const T& obj, const Cursor& at, const YAML::Node& node) { check(obj.*member, at, node); });
+    moved_blocks_.insert(moved_blocks_.end(), sub.moved_blocks_.begin(), sub.moved_blocks_.end());
+    upgrades_.insert(upgrades_.end(), sub.upgrades_.begin(), sub.upgrades_.end());
   }
 
   // `old_key: {...}` of older configs, whose keys now sit at this level (e.g. `search: {strategy:

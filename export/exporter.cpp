@@ -24,7 +24,7 @@ std::vector<std::pair<std::string, std::string>> export_metadata(const SRNetwork
   if (net.has_rit()) {
     m.emplace_back("cgsr.render_channels", join(spec.rit.channels));
     m.emplace_back("cgsr.render_info_size", spec.rit.reads_hr() ? "hr" : "lr");
-    m.emplace_back("cgsr.depth_encoding", spec.rit.depth_encoding);
+    m.emplace_back("cgsr.depth_encoding", enum_name(spec.rit.depth_encoding));
   }
   return m;
 }

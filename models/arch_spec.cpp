@@ -165,10 +165,6 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.width", "must be at least 1, got " + std::to_string(spec.rit.width)});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", "must be at least 1, got " + std::to_string(spec.rit.hr_width)});
-  if (std::find(EnumNames<DepthEncoding>::names().begin(), EnumNames<DepthEncoding>::names().end(), spec.rit.depth_encoding) ==
-      EnumNames<DepthEncoding>::names().end())
-    problems.push_back({"rit.depth_encoding",
-                        "'" + spec.rit.depth_encoding + "' is not one of: " + join(EnumNames<DepthEncoding>::names(), ", ")});
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -236,8 +232,7 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("source", &RitSpec::source, "where the rendering information comes from and joins the backbone");
   rit.field("hr_width", &RitSpec::hr_width, "features of the HR branch (hr_fuse)").at_least(1);
   rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone");
-  rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network")
-      .one_of(EnumNames<DepthEncoding>::names());
+  rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network");
   return rit;
 }
 
@@ -302,7 +297,7 @@ std::string spec_summary(const ArchSpec& spec) {
     std::string widths;
     if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
-    s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + r.depth_encoding +
+    s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
          " depth]";
   }
   if (spec.geometry.enabled) s += " + geometry head";

@@ -100,11 +100,10 @@ struct RitSpec {
   RitSource source = RitSource::Lr;
   int hr_width = 16;              // features of the HR branch (layer group "rit_hr")
   RitFusion fusion = RitFusion::Concat;
-  std::string depth_encoding = "log";  // log | linear | zbuffer
+  DepthEncoding depth_encoding = DepthEncoding::Log;  // log, linear or zbuffer in YAML
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
-  DepthEncoding depth() const { return enum_from_name<DepthEncoding>(depth_encoding); }
   // The parts the source asks for: the block at the backbone's feature map (lr, hr_pooled,
   // hr_unshuffle) and the branch at the HR features (hr_fuse).
   bool feature_branch() const { return source != RitSource::HrFuse; }

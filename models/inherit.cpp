@@ -88,8 +88,8 @@ std::vector<std::string> inheritance_problems(const ArchSpec& parent, const Arch
       if (std::find(parent.rit.channels.begin(), parent.rit.channels.end(), c) == parent.rit.channels.end())
         p.push_back("rit channel " + c + " is not read by the parent (" + join(parent.rit.channels) + ")");
     if (child.rit.depth_encoding != parent.rit.depth_encoding)
-      p.push_back("rit.depth_encoding " + child.rit.depth_encoding + " differs from the parent's " +
-                  parent.rit.depth_encoding);
+      p.push_back("rit.depth_encoding " + enum_name(child.rit.depth_encoding) + " differs from the parent's " +
+                  enum_name(parent.rit.depth_encoding));
     if (child.rit.width > parent.rit.width)
       p.push_back("rit.width " + std::to_string(child.rit.width) + " exceeds the parent's " +
                   std::to_string(parent.rit.width));

@@ -219,29 +219,13 @@ uint64_t model_file_checksum(std::string_view bytes) {
   return fnv1a64(bytes, version1 ? kLegacyFnv1a64Basis : kFnv1a64OffsetBasis);
 }
 
-nlohmann::ordered_json to_json(const Provenance& p) {
-  nlohmann::ordered_json j;
-  j["stage"] = p.stage;
-  j["parent"] = p.parent;
-  j["config"] = p.config;
-  j["metrics"] = p.metrics;
-  j["extra"] = p.extra;
-  return j;
-}
-
 Provenance provenance_from_json(const nlohmann::ordered_json& j, const std::string& context) {
   if (!j.is_object()) throw Error(context, "provenance must be a JSON object");
-  Provenance p;
   try {
-    p.stage = j.value("stage", std::string());
-    p.parent = j.value("parent", std::string());
+    return j.get<Provenance>();
   } catch (const nlohmann::json::exception& e) {
     throw Error(context, std::string("provenance: ") + e.what());
   }
-  if (j.contains("config")) p.config = j["config"];
-  if (j.contains("metrics")) p.metrics = j["metrics"];
-  if (j.contains("extra")) p.extra = j["extra"];
-  return p;
 }
 
 void write_model_file(const std::filesystem::path& path, const ModelFileContents& contents) {
@@ -250,7 +234,7 @@ void write_model_file(const std::filesystem::path& path, const ModelFileContents
   meta["version"] = kVersion;
   meta["spec"] = spec_to_yaml(contents.spec);
   meta["channels"] = channel_names(contents.spec.input_channels());
-  meta["provenance"] = to_json(contents.provenance);
+  meta["provenance"] = contents.provenance;
   const std::string where = path.string();
   if (contents.tensors.size() > kMaxModelTensors)
     throw Error(where, std::to_string(contents.tensors.size()) + " tensors, more than a model file holds (" +

@@ -35,6 +35,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/json_fields.h"
 #include "models/arch_spec.h"
 #include "models/sr_network.h"
 
@@ -49,7 +50,8 @@ struct Provenance {
   nlohmann::ordered_json extra = nlohmann::ordered_json::object();    // anything else a stage records
 };
 
-nlohmann::ordered_json to_json(const Provenance& p);
+CGSR_JSON_FIELDS_WITH_DEFAULT(Provenance, stage, parent, config, metrics, extra)  // a missing key: its default
+// A file's provenance object; an Error naming `context` when it is not one.
 Provenance provenance_from_json(const nlohmann::ordered_json& j, const std::string& context);
 
 // Tensors named with this prefix are not network parameters but data of a later stage (pruning

@@ -77,10 +77,10 @@ torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
 void SRNetworkImpl::check_depth_encoding(const Batch& batch) const {
   const auto reads = input_channels();
   if (std::find(reads.begin(), reads.end(), RenderChannel::Depth) == reads.end() ||
-      batch.depth_encoding == spec_.rit.depth())
+      batch.depth_encoding == spec_.rit.depth_encoding)
     return;
   throw Error(spec_summary(spec_), std::string("the batch's depth is ") + enum_name(batch.depth_encoding) +
-                                       "-encoded, the model reads " + spec_.rit.depth_encoding +
+                                       "-encoded, the model reads " + enum_name(spec_.rit.depth_encoding) +
                                        " (build batches with the model's depth_encoding())");
 }
 

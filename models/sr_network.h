@@ -46,7 +46,7 @@ class SRNetworkImpl : public torch::nn::Module {
   // What the network takes from a Batch: its rendering channels at the resolution the spec asks
   // for (undefined without RIT), and the target of the geometry head (the HR channels). The
   // batch's depth must be in depth_encoding() (an Error says so otherwise).
-  DepthEncoding depth_encoding() const { return spec_.rit.depth(); }
+  DepthEncoding depth_encoding() const { return spec_.rit.depth_encoding; }
   torch::Tensor info_input(const Batch& batch) const;
   torch::Tensor geometry_target(const Batch& batch) const;
 

@@ -20,16 +20,13 @@ const PrunedBaseline* PruneRoles::baseline(const std::string& type) const {
 }
 
 nlohmann::ordered_json to_json(const PruneRoles& roles) {
-  const auto model = [](const PrunedModel& m) {
-    return nlohmann::ordered_json{{"name", m.name}, {"file", m.file.string()}};
-  };
   nlohmann::ordered_json j;
-  j["input"] = model(roles.input);
-  j["hybrid"] = model(roles.hybrid);
-  j["static"] = model(roles.static_network);
+  j["input"] = roles.input;
+  j["hybrid"] = roles.hybrid;
+  j["static"] = roles.static_network;
   j["baselines"] = nlohmann::ordered_json::array();
   for (const auto& b : roles.baselines) {
-    auto entry = model(b);
+    nlohmann::ordered_json entry = static_cast<const PrunedModel&>(b);
     entry["type"] = b.options.type;
     entry["requested_keep_rate"] = b.options.keep_rate;
     entry["keep_rate"] = b.keep_rate;
@@ -39,18 +36,14 @@ nlohmann::ordered_json to_json(const PruneRoles& roles) {
 }
 
 PruneRoles prune_roles_from_json(const nlohmann::ordered_json& j, const std::string& where) {
-  const auto model = [](const nlohmann::ordered_json& m, PrunedModel& out) {
-    out.name = m.at("name").get<std::string>();
-    out.file = m.at("file").get<std::string>();
-  };
   PruneRoles roles;
   try {
-    model(j.at("input"), roles.input);
-    model(j.at("hybrid"), roles.hybrid);
-    model(j.at("static"), roles.static_network);
+    j.at("input").get_to(roles.input);
+    j.at("hybrid").get_to(roles.hybrid);
+    j.at("static").get_to(roles.static_network);
     for (const auto& b : j.at("baselines")) {
       PrunedBaseline baseline;
-      model(b, baseline);
+      b.get_to(static_cast<PrunedModel&>(baseline));
       baseline.options.type = b.at("type").get<std::string>();
       baseline.options.keep_rate = b.at("requested_keep_rate").get<double>();
       baseline.keep_rate = b.at("keep_rate").get<double>();

@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "core/config.h"
+#include "core/json_fields.h"
 #include "models/model_file.h"
 #include "pruning/baseline_pruning.h"
 #include "pruning/dynamic_pruning.h"
@@ -56,6 +57,7 @@ struct PrunedModel {
   std::string name;            // display name in the evaluations
   std::filesystem::path file;  // its model file
 };
+CGSR_JSON_FIELDS(PrunedModel, name, file)
 struct PrunedBaseline : PrunedModel {
   BaselineOptions options;
   double keep_rate = 0;  // the rate used (matched to the hybrid's MACs when options.keep_rate is 0)

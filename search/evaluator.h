@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/json_fields.h"
 #include "models/arch_spec.h"
 
 namespace cgsr {
@@ -20,8 +21,8 @@ struct CandidateScore {
   double train_seconds = 0;
 };
 
-nlohmann::ordered_json to_json(const CandidateScore& score);
-CandidateScore candidate_score_from_json(const nlohmann::json& j);
+// A search history line's and a distributed reply's "score"; latency_ms is null when not measured.
+CGSR_JSON_FIELDS(CandidateScore, val_psnr, val_ssim, image_loss, geometry_loss, params, macs, latency_ms, train_seconds)
 
 class Evaluator {
  public:

@@ -31,7 +31,7 @@ SearchHistory::SearchHistory(std::filesystem::path path, bool resume) : path_(st
       e.generation = j.at("generation");
       e.spec = spec_from_yaml(j.at("spec").get<std::string>(), path_.string() + ":" + std::to_string(line_number));
       e.key = j.at("key");
-      e.score = candidate_score_from_json(j.at("score"));
+      e.score = j.at("score").get<CandidateScore>();
       index_[e.key] = entries_.size();
       entries_.push_back(std::move(e));
       valid_end = end + 1;
@@ -57,7 +57,7 @@ void SearchHistory::append(const HistoryEntry& entry) {
   j["key"] = entry.key;
   j["spec"] = spec_to_yaml(entry.spec);
   j["summary"] = spec_summary(entry.spec);
-  j["score"] = to_json(entry.score);
+  j["score"] = entry.score;
   const std::string line = j.dump() + "\n";
   // One write of a whole line, then fsync: a kill leaves at most one partial last line.
   const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);

@@ -34,9 +34,8 @@ struct SearchOptions {
 };
 config::Schema<SearchOptions> search_schema();
 // The former shape, `strategy: evolution` with a shared `operators: {...}` block, rewritten into
-// the strategy block (with a deprecation warning). search_schema() applies it; a schema that
-// inlines the search options (config::Schema::inline_section takes fields, not upgrades) adds it
-// itself with upgrade().
+// the strategy block (with a deprecation warning). search_schema() applies it, and so does a
+// schema that inlines the search options (config::Schema::inline_section carries upgrades).
 YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cursor& at);
 
 struct SearchResult {

@@ -36,8 +36,7 @@ config::Schema<TrainSchedule> schedule_schema() {
           "consecutive steps with a non-finite loss or gradient before training stops")
       .at_least(1);
   s.field("layout", &TrainSchedule::layout,
-          "activation memory layout: auto measures both on the first batch and keeps the faster")
-      .one_of({"auto", "nchw", "nhwc"});
+          "activation memory layout: auto measures both on the first batch and keeps the faster");
   s.field("prefetch", &TrainSchedule::prefetch,
           "batches built ahead on other threads; 0 builds each on the training thread between steps "
           "(no thread competes with the compute threads)")
@@ -67,11 +66,8 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
   j["seconds"] = o.seconds;
   j["patches_per_second"] = o.patches_per_second;
   j["resumed"] = o.resumed;
-  j["layout"] = o.layout;
-  const StepPhases& p = o.phase_ms;
-  j["phase_ms"] = {{"batch", p.batch},         {"forward_and_loss", p.forward_and_loss},
-                   {"backward_and_clip", p.backward_and_clip}, {"optimizer", p.optimizer},
-                   {"validation", p.validation}, {"checkpoint", p.checkpoint}};
+  j["layout"] = enum_name(o.layout);
+  j["phase_ms"] = o.phase_ms;
   j["best"] = score(o.best);
   j["last"] = score(o.last);
   j["history"] = nlohmann::ordered_json::array();
@@ -192,8 +188,7 @@ TrainOutput Trainer::forward(const Batch& batch, int step) {
 }
 
 MemoryLayout Trainer::choose_layout(const Batch& batch) {
-  const MemoryLayout requested = enum_from_name<MemoryLayout>(schedule_.layout);
-  if (requested != MemoryLayout::Auto) return requested;
+  if (schedule_.layout != MemoryLayout::Auto) return schedule_.layout;
   // Forward and backward without hooks or optimizer step: gradients are zeroed before every
   // real step, so the measurement leaves nothing behind.
   const auto shape = batch.lr_color.sizes();
@@ -381,7 +376,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   if (world_) layout_ = enum_from_name<MemoryLayout>(world_->broadcast("layout", enum_name(layout_)));
   set_parameter_layout(*network_, layout_);
   if (world_) world_->broadcast_tensors(tracked());  // every rank starts from rank 0's weights
-  outcome.layout = enum_name(layout_);
+  outcome.layout = layout_;
 
   network_->train();
   Progress progress("train", schedule_.steps, step);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "core/json_fields.h"
 #include "models/memory_layout.h"
 #include "models/model_file.h"
 #include "models/sr_network.h"
@@ -46,7 +47,7 @@ struct TrainSchedule {
   int val_frames = 8;           // validation frames (spread over the split); 0 = all
   int checkpoint_every = 100;   // steps
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
-  std::string layout = "auto";  // activation memory layout: auto (measured) | nchw | nhwc
+  MemoryLayout layout = MemoryLayout::Auto;  // activation memory layout: auto (measured), nchw or nhwc
   int prefetch = 2;             // batches built ahead on other threads (0: between steps)
 };
 config::Schema<TrainSchedule> schedule_schema();
@@ -63,6 +64,7 @@ struct ValidationScore {
 struct StepPhases {
   double batch = 0, forward_and_loss = 0, backward_and_clip = 0, optimizer = 0, validation = 0, checkpoint = 0;
 };
+CGSR_JSON_FIELDS(StepPhases, batch, forward_and_loss, backward_and_clip, optimizer, validation, checkpoint)
 
 struct TrainOutcome {
   int steps = 0;
@@ -73,7 +75,7 @@ struct TrainOutcome {
   std::vector<ValidationScore> history;
   std::vector<double> loss_curve;  // training loss (the CGSR total) of every step, over the global batch
   bool resumed = false;
-  std::string layout;  // the memory layout the steps ran in
+  MemoryLayout layout = MemoryLayout::Nchw;  // the memory layout the steps ran in
   StepPhases phase_ms;  // over the steps this run took (a resumed run: since the resume)
 };
 nlohmann::ordered_json to_json(const TrainOutcome& outcome);

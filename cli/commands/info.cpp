@@ -73,7 +73,7 @@ nlohmann::ordered_json describe_model(const InfoOptions& options) {
   j["spec"] = yaml_to_json(spec_to_node(spec));
   j["channels"] = channel_names(spec.input_channels());
   j["training_only_params"] = total_parameter_count(*source.network) - cost.params;
-  if (source.provenance) j["provenance"] = to_json(*source.provenance);
+  if (source.provenance) j["provenance"] = *source.provenance;
   j["complexity"] = to_json(cost);
   return j;
 }

@@ -21,8 +21,9 @@ config::Schema<SearchCommandOptions> search_command_schema() {
   s.field("parent", &SearchCommandOptions::parent, "CG-enhanced model file to start from").required();
   s.field("data", &SearchCommandOptions::data, "data set directory").required();
   s.inline_section(&SearchCommandOptions::search, search_schema());
-  s.moved_block("search");  // configs before the search options moved up: `search: {strategy: ...}`
-  s.upgrade(move_operators_into_strategy);  // lifted from `search:` or at the top
+  // Configs before the search options moved up: `search: {strategy: ...}`; the inlined options'
+  // upgrade (a former `operators:` block) then reads it whether lifted from there or at the top.
+  s.moved_block("search");
   s.section("candidate", &SearchCommandOptions::candidate, candidate_training_schema(), "training of each candidate");
   s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
   s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
@@ -136,7 +137,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
                             "\n" + config::to_yaml(candidate_training_schema().emit(options.candidate));
     world = join_run(options.distributed, job);
     queue.emplace(*world);
-    if (options.candidate.schedule.layout == "auto")
+    if (options.candidate.schedule.layout == MemoryLayout::Auto)
       spdlog::warn("candidate.schedule.layout is auto: each process measures its own memory layout, so a score can "
                    "differ in the last digits from a 1-process run (set nchw or nhwc for identical ones)");
     if (!world->coordinator()) {
@@ -186,10 +187,10 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   nlohmann::ordered_json j;
   j["name"] = name;
   j["model"] = run_dir.file("model.cgsr").string();
-  j["parent"] = {{"spec", spec_summary(result.parent.spec)}, {"score", to_json(result.parent.score)}};
+  j["parent"] = {{"spec", spec_summary(result.parent.spec)}, {"score", result.parent.score}};
   j["pick"] = {{"spec", spec_summary(result.pick.spec)},
                {"spec_yaml", spec_to_yaml(result.pick.spec)},
-               {"score", to_json(result.pick.score)},
+               {"score", result.pick.score},
                {"is_parent", result.pick_is_parent}};
   j["param_reduction"] = reduction;
   j["pareto_front"] = nlohmann::ordered_json::array();

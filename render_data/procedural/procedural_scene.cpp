@@ -46,9 +46,9 @@ class LevelBuilder {
     grid_.cell = o.cell;
     grid_.kind.assign(static_cast<size_t>(grid_.nx) * grid_.nz, Free);
     grid_.height.assign(grid_.kind.size(), 0.0f);
-    arena_ = o.layout == "arena";
-    hall_ = o.layout == "hall";
-    outdoor_ = o.layout == "outdoor";
+    arena_ = o.layout == ProceduralLayout::Arena;
+    hall_ = o.layout == ProceduralLayout::Hall;
+    outdoor_ = o.layout == ProceduralLayout::Outdoor;
     open_sky_ = arena_ || outdoor_;
     variety_ = o.variety.enabled;
     ceiling_ = o.ceiling && !open_sky_;
@@ -58,11 +58,15 @@ class LevelBuilder {
 
   SceneBundle build() {
     scene_.name = o_.name;
-    if (o_.layout == "room") layout_room();
-    else if (o_.layout == "corridors") layout_corridors();
-    else if (o_.layout == "hall") layout_hall();
-    else if (o_.layout == "outdoor") layout_outdoor();
-    else layout_arena();
+    switch (o_.layout) {
+      case ProceduralLayout::Room: layout_room(); break;
+      case ProceduralLayout::Corridors: layout_corridors(); break;
+      case ProceduralLayout::Hall: layout_hall(); break;
+      case ProceduralLayout::Outdoor: layout_outdoor(); break;
+      case ProceduralLayout::Arena: layout_arena(); break;
+      case ProceduralLayout::Random:
+        throw Error("procedural scene '" + o_.name + "'", "layout random reached the builder undrawn", ErrorKind::Internal);
+    }
     build_structure();
     const auto walk = camera_walk();
     for (const auto& [x, z] : walk) grid_.at(x, z) = Path;
@@ -832,11 +836,15 @@ config::Schema<ProceduralFog> fog_schema() {
 
 }  // namespace
 
+const std::vector<std::string>& EnumNames<ProceduralLayout>::names() {
+  static const std::vector<std::string> names = {"room", "corridors", "hall", "arena", "outdoor", "random"};
+  return names;
+}
+
 config::Schema<ProceduralOptions> procedural_schema() {
   config::Schema<ProceduralOptions> s;
   s.field("name", &ProceduralOptions::name, "scene name");
-  s.field("layout", &ProceduralOptions::layout, "level layout (random: drawn from variety.layouts)")
-      .one_of({"room", "corridors", "hall", "arena", "outdoor", "random"});
+  s.field("layout", &ProceduralOptions::layout, "level layout (random: drawn from variety.layouts)");
   s.field("variant", &ProceduralOptions::variant, "0: the level of the render seed; N: another level of the same seed")
       .range(0, 1000000000);
   s.field("size", &ProceduralOptions::size, "grid cells [x, z]")
@@ -857,7 +865,8 @@ config::Schema<ProceduralOptions> procedural_schema() {
   s.section("variety", &ProceduralOptions::variety, variety_schema(),
             "ranges the layout, size, materials, lights, fog and sky are drawn from per seed (procedural_variety.h)");
   s.validate([](const ProceduralOptions& o, const config::Cursor& at, const YAML::Node& node) {
-    if (o.layout != "arena" && o.layout != "outdoor" && o.layout != "random" && !node["variety"] &&
+    if (o.layout != ProceduralLayout::Arena && o.layout != ProceduralLayout::Outdoor &&
+        o.layout != ProceduralLayout::Random && !node["variety"] &&
         o.height < o.camera.eye_height + 0.8f)
       at.child("height").fail(node, "rooms, corridors and halls need walls at least 0.8 m above the camera's eye height");
   });
@@ -875,10 +884,10 @@ uint64_t procedural_level_seed(const ProceduralOptions& options, uint64_t seed) 
 SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed) {
   const uint64_t level_seed = procedural_level_seed(options, seed);
   ProceduralOptions drawn = options;
-  drawn.variety.enabled |= options.layout == "random";
+  drawn.variety.enabled |= options.layout == ProceduralLayout::Random;
   const ProceduralOptions level = draw_variety(drawn, level_seed);
   if (level.variety.enabled)  // what the seed drew, so a user can find a level again
-    spdlog::info("procedural scene '{}': {} layout, {}x{} cells, {} point lights, fog {}", level.name, level.layout,
+    spdlog::info("procedural scene '{}': {} layout, {}x{} cells, {} point lights, fog {}", level.name, enum_name(level.layout),
                  level.size[0], level.size[1], level.lighting.point_lights, level.fog.density > 0 ? "on" : "off");
   return LevelBuilder(level, level_seed).build();
 }

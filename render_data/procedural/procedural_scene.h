@@ -30,6 +30,15 @@
 
 namespace cgsr {
 
+// The level's plan: room | corridors | hall | arena | outdoor, or random (drawn from
+// variety.layouts by the seed; a level is never built as random).
+enum class ProceduralLayout { Room, Corridors, Hall, Arena, Outdoor, Random };
+template <>
+struct EnumNames<ProceduralLayout> {
+  static constexpr const char* kind = "procedural layout";
+  static const std::vector<std::string>& names();  // room, corridors, hall, arena, outdoor, random
+};
+
 struct ProceduralProps {
   int crates = 6, pillars = 4, spheres = 3, tori = 2, stairs = 1, fences = 2, railings = 2, wires = 4, signs = 3;
   int grates = 0;  // free-standing grate panels (alpha-tested bars), thin like fences
@@ -38,7 +47,8 @@ struct ProceduralProps {
 // Ranges the level's options are drawn from (procedural_variety.h); every [lo, hi] is inclusive.
 struct ProceduralVariety {
   bool enabled = false;  // set when the scene block has `variety` or `layout: random`
-  std::vector<std::string> layouts = {"room", "corridors", "hall", "arena", "outdoor"};  // for layout: random
+  std::vector<ProceduralLayout> layouts = {ProceduralLayout::Room, ProceduralLayout::Corridors, ProceduralLayout::Hall,
+                                          ProceduralLayout::Arena, ProceduralLayout::Outdoor};  // for layout: random
   std::vector<int> size = {7, 14};                   // grid cells per side
   std::vector<std::string> materials = {"bricks", "tiles", "checker", "noise", "planks", "glyphs", "plates",
                                         "stripes", "grate", "grid",  "tread",   "hexes"};  // texture families
@@ -81,7 +91,7 @@ struct ProceduralFog {
 
 struct ProceduralOptions {
   std::string name = "procedural";
-  std::string layout = "room";
+  ProceduralLayout layout = ProceduralLayout::Room;
   int variant = 0;           // 0: the level of the render seed; N: another level from the same seed
   std::vector<int> size = {10, 8};
   float cell = 2.5f;

@@ -22,8 +22,12 @@ int scaled(int count, float factor) { return static_cast<int>(std::lround(count 
 config::Schema<ProceduralVariety> variety_schema() {
   config::Schema<ProceduralVariety> s;
   s.field("layouts", &ProceduralVariety::layouts, "layouts that layout: random draws from")
-      .one_of({"room", "corridors", "hall", "arena", "outdoor"})
-      .check([](const std::vector<std::string>& v) { return !v.empty(); }, "needs at least one layout");
+      .check([](const std::vector<ProceduralLayout>& v) { return !v.empty(); }, "needs at least one layout")
+      .check(
+          [](const std::vector<ProceduralLayout>& v) {
+            return std::find(v.begin(), v.end(), ProceduralLayout::Random) == v.end();
+          },
+          "random draws from this list; name layouts (room, corridors, hall, arena, outdoor)");
   s.field("size", &ProceduralVariety::size, "grid cells per side, [lo, hi]")
       .range(5, 60)
       .check(is_range<int>, kRangeMessage);
@@ -81,11 +85,11 @@ ProceduralOptions draw_variety(const ProceduralOptions& options, uint64_t seed) 
   const ProceduralVariety& v = options.variety;
   ProceduralRng rng(seed ^ 0x7661726965747921ULL);  // a stream of its own ("variety!")
   ProceduralOptions o = options;
-  if (o.layout == "random") o.layout = rng.pick(v.layouts);
+  if (o.layout == ProceduralLayout::Random) o.layout = rng.pick(v.layouts);
   o.size = {rng.between(v.size[0], v.size[1]), rng.between(v.size[0], v.size[1])};
-  if (o.layout == "room") o.height = rng.range(3.2f, 5.0f);
-  else if (o.layout == "corridors") o.height = rng.range(2.8f, 4.0f);
-  else if (o.layout == "hall") o.height = rng.range(7.0f, 11.0f);
+  if (o.layout == ProceduralLayout::Room) o.height = rng.range(3.2f, 5.0f);
+  else if (o.layout == ProceduralLayout::Corridors) o.height = rng.range(2.8f, 4.0f);
+  else if (o.layout == ProceduralLayout::Hall) o.height = rng.range(7.0f, 11.0f);
   o.height = std::max(o.height, o.camera.eye_height + 0.9f);
   o.texel_density *= rng.range(v.pattern_scale[0], v.pattern_scale[1]);
 
@@ -96,7 +100,7 @@ ProceduralOptions draw_variety(const ProceduralOptions& options, uint64_t seed) 
   p.grates = scaled(std::max(p.grates, rng.between(1, 3)), thin);
 
   auto& L = o.lighting;
-  const bool open_sky = o.layout == "arena" || o.layout == "outdoor";
+  const bool open_sky = o.layout == ProceduralLayout::Arena || o.layout == ProceduralLayout::Outdoor;
   const float brightness = rng.range(v.brightness[0], v.brightness[1]);
   L.point_lights = rng.between(v.lights[0], v.lights[1]);
   L.point_intensity *= brightness;

@@ -259,6 +259,65 @@ TEST(Config, AnInlineSectionReadsAtTheTopAndItsFormerBlockStillReads) {
   }
 }
 
+namespace {
+// A lens whose field of view was once `angle` (an older shape, upgraded with a warning), inlined
+// into a shot: the upgrade must reach the shot's top level, where the lens keys now sit.
+struct Lens {
+  double fov = 60.0;
+};
+Schema<Lens> lens_schema() {
+  Schema<Lens> s;
+  s.field("fov", &Lens::fov, "vertical field of view in degrees").range(1, 179);
+  s.upgrade([](const YAML::Node& map, const Cursor& at) {
+    if (!map || !map.IsMap() || !map["angle"]) return map;
+    warn_deprecated(at.doc ? at.doc->locate(map["angle"]) : at.path,
+                    "'" + at.child("angle").path + "' is deprecated: write '" + at.child("fov").path + "'");
+    YAML::Node out(YAML::NodeType::Map);
+    for (const auto& kv : map) out.force_insert(kv.first.Scalar() == "angle" ? YAML::Node("fov") : kv.first, kv.second);
+    return out;
+  });
+  return s;
+}
+struct Shot {
+  std::string name;
+  Lens lens;  // its keys sit at the top level of a shot
+};
+Schema<Shot> shot_schema() {
+  Schema<Shot> s;
+  s.field("name", &Shot::name, "shot name");
+  s.inline_section(&Shot::lens, lens_schema());
+  s.moved_block("lens");
+  return s;
+}
+}  // namespace
+
+TEST(Config, AnInlineSectionCarriesItsSchemasUpgrades) {
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  spdlog::default_logger()->sinks().push_back(sink);
+  const Shot flat = parse_document(Document::parse("name: a\nangle: 30\n", "shot.yaml"), shot_schema());
+  // The same old key inside the section's former block: lifted first, then upgraded.
+  const Shot nested = parse_document(Document::parse("name: b\nlens: {angle: 40}\n", "old-shot.yaml"), shot_schema());
+  spdlog::default_logger()->sinks().pop_back();
+  EXPECT_DOUBLE_EQ(flat.lens.fov, 30);
+  EXPECT_DOUBLE_EQ(nested.lens.fov, 40);
+  const std::string warning = log.str();
+  EXPECT_NE(warning.find("shot.yaml:2:8: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("old-shot.yaml:2:15: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("old-shot.yaml:2:1: 'lens' is deprecated"), std::string::npos) << warning;
+  // Emitted in the current shape, which reads back without a warning.
+  const std::string emitted = to_yaml(shot_schema().emit(flat));
+  EXPECT_EQ(emitted.find("angle"), std::string::npos) << emitted;
+  EXPECT_NE(emitted.find("fov: 30"), std::string::npos) << emitted;
+  // The upgraded key is checked like a current one, at the old key's value.
+  try {
+    parse_document(Document::parse("angle: 300\n", "shot.yaml"), shot_schema());
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("shot.yaml:1:8: fov: must be in [1, 179]"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Config, AKeyThatIsAListReachesJsonAsItsYamlText) {
   // A raw block keeps such a key until its schema rejects it; recording the config must not fail
   // first (`cgsr run` with `train: {? [a, b]: 1}` was an internal yaml-cpp error).

@@ -106,6 +106,22 @@ TEST(ArchSpec, TyposPointAtFileLineAndColumn) {
 
   e = parse_error("backbone: pan\nrit: {enabled: true, fusion: concatenate}\n");
   EXPECT_NE(e.find("not one of: concat, add"), std::string::npos) << e;
+
+  e = parse_error("backbone: pan\nrit:\n  enabled: true\n  depth_encoding: logg\n");
+  EXPECT_NE(e.find("spec.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("rit.depth_encoding"), std::string::npos) << e;
+  EXPECT_NE(e.find("'logg' is not one of: log, linear, zbuffer"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'log'"), std::string::npos) << e;
+}
+
+// rit.depth_encoding is an enum in code and its name in YAML: each spelling reads back as itself.
+TEST(ArchSpec, DepthEncodingIsParsedOnceAndWrittenByName) {
+  for (const auto& name : EnumNames<DepthEncoding>::names()) {
+    const ArchSpec s = spec_from_yaml("backbone: pan\nrit: {enabled: true, depth_encoding: " + name + "}\n", "spec");
+    EXPECT_EQ(enum_name(s.rit.depth_encoding), name);
+    EXPECT_NE(spec_to_yaml(s).find("depth_encoding: " + name + "\n"), std::string::npos) << spec_to_yaml(s);
+  }
+  EXPECT_EQ(default_spec("pan", 2).rit.depth_encoding, DepthEncoding::Log);
 }
 
 TEST(ArchSpec, InconsistentCombinationsAreErrors) {

@@ -199,11 +199,11 @@ const fs::path kVersion1File = fs::path(CGSR_SOURCE_DIR) / "tests/data/model_fil
 TEST(ModelFile, FilesFromBeforeDepthEncodingsReadZBufferDepth) {
   const auto dir = scratch_dir("model-file-legacy");
   SRNetwork net = build_network(with_rit(default_spec("pan", 2)), 11);
-  EXPECT_EQ(net->spec().rit.depth_encoding, "log");  // what new networks read
+  EXPECT_EQ(net->spec().rit.depth_encoding, DepthEncoding::Log);  // what new networks read
   save_model(dir / "old.cgsr", *net);
   drop_depth_encoding(dir / "old.cgsr");
   Model old = load_model(dir / "old.cgsr");
-  EXPECT_EQ(old.network->spec().rit.depth_encoding, "zbuffer");
+  EXPECT_EQ(old.network->spec().rit.depth_encoding, DepthEncoding::ZBuffer);
   EXPECT_EQ(old.network->depth_encoding(), DepthEncoding::ZBuffer);
   // Same weights, same function: only the input contract differs.
   const auto [color, info] = random_inputs(net->spec(), 6, 5);
@@ -367,4 +367,24 @@ TEST(ModelFile, ASpecFarLargerThanItsWeightsIsRefusedBeforeBuilding) {
   const auto what = error_of([&] { load_model(path); });
   EXPECT_NE(what.find(path.string() + ": the spec describes a network of more than"), std::string::npos) << what;
   fs::remove_all(dir);
+}
+
+// The provenance object of a model file's metadata: its keys in order, and missing keys (older
+// files) read as their defaults.
+TEST(ModelFile, ProvenanceJsonKeepsItsKeysAndReadsMissingOnesAsDefaults) {
+  Provenance p;
+  p.stage = "pruned";
+  p.parent = "search/model.cgsr";
+  p.metrics = {{"psnr", 30.5}};
+  EXPECT_EQ(nlohmann::ordered_json(p).dump(),
+            R"({"stage":"pruned","parent":"search/model.cgsr","config":{},"metrics":{"psnr":30.5},"extra":{}})");
+  const Provenance back = provenance_from_json(nlohmann::ordered_json(p), "m.cgsr");
+  EXPECT_EQ(back.stage, p.stage);
+  EXPECT_EQ(back.metrics, p.metrics);
+  const Provenance old = provenance_from_json(nlohmann::ordered_json::parse(R"({"stage":"backbone"})"), "m.cgsr");
+  EXPECT_EQ(old.stage, "backbone");
+  EXPECT_EQ(old.parent, "");
+  EXPECT_TRUE(old.config.is_object() && old.config.empty());
+  EXPECT_THROW(provenance_from_json(nlohmann::ordered_json::parse(R"({"stage":3})"), "m.cgsr"), Error);
+  EXPECT_THROW(provenance_from_json(nlohmann::ordered_json::array(), "m.cgsr"), Error);
 }

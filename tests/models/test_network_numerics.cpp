@@ -183,7 +183,7 @@ TEST(NetworkNumerics, ExtremeRenderingInformationGivesFiniteOutputsForEveryRitSo
       const DepthEncoding encoding = enum_from_name<DepthEncoding>(encoding_name);
       SCOPED_TRACE(c.name() + ", " + encoding_name + " depth");
       ArchSpec spec = small_spec(c.backbone, c.source);
-      spec.rit.depth_encoding = encoding_name;
+      spec.rit.depth_encoding = encoding;
       Engines e(resolve_spec(spec), ++seed);
       const auto color = torch::rand({1, 3, h, w});
       const int64_t f = e.net->rit()->info_factor();

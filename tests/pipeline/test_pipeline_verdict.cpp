@@ -64,6 +64,9 @@ TEST(PipelineVerdict, TheExpectedStoryPassesEveryCheck) {
   EXPECT_TRUE(v.passed()) << v.text();
   EXPECT_NE(v.text().find("all 15 checks pass"), std::string::npos);
   EXPECT_EQ(v.to_json()["passed"], true);
+  const auto first = v.to_json()["checks"][0];
+  EXPECT_EQ(first.dump(), nlohmann::ordered_json({{"claim", v.checks[0].claim}, {"passed", true}, {"detail", v.checks[0].detail}}).dump());
+  EXPECT_EQ(Verdict{}.to_json().dump(), R"({"passed":true,"checks":[]})");
 }
 
 TEST(PipelineVerdict, EachClaimFailsOnItsOwn) {

@@ -97,3 +97,33 @@ TEST(PruneCli, PrunesATinySceneEndToEnd) {
   EXPECT_NE(r.err.find("missing.cgsr"), std::string::npos) << r.err;
   std::filesystem::remove_all(dir);
 }
+
+// The roles block of a prune stage's results.json, which `cgsr run` reads back on a rerun.
+TEST(PruneRoles, JsonKeepsItsFormatAndReadsBack) {
+  PruneRoles roles;
+  roles.input = {"cg-optimized", "in/model.cgsr"};
+  roles.hybrid = {"hybrid", "out/pruned.cgsr"};
+  roles.static_network = {"static", "out/pruned.cgsr"};
+  PrunedBaseline mmp;
+  mmp.name = "mmp";
+  mmp.file = "out/mmp.cgsr";
+  mmp.options.type = "magnitude";
+  mmp.options.keep_rate = 0;
+  mmp.keep_rate = 0.5;
+  roles.baselines.push_back(mmp);
+  const auto j = to_json(roles);
+  EXPECT_EQ(j.dump(), R"({"input":{"name":"cg-optimized","file":"in/model.cgsr"},)"
+                      R"("hybrid":{"name":"hybrid","file":"out/pruned.cgsr"},)"
+                      R"("static":{"name":"static","file":"out/pruned.cgsr"},)"
+                      R"("baselines":[{"name":"mmp","file":"out/mmp.cgsr","type":"magnitude",)"
+                      R"("requested_keep_rate":0.0,"keep_rate":0.5}]})");
+  const PruneRoles back = prune_roles_from_json(j, "results.json");
+  EXPECT_EQ(back.static_network.file, roles.static_network.file);
+  ASSERT_EQ(back.baselines.size(), 1u);
+  EXPECT_EQ(back.baselines[0].name, "mmp");
+  EXPECT_EQ(back.baselines[0].file, "out/mmp.cgsr");
+  EXPECT_EQ(back.baselines[0].keep_rate, 0.5);
+  auto broken = j;
+  broken["hybrid"].erase("file");
+  EXPECT_THROW(prune_roles_from_json(broken, "results.json"), Error);
+}

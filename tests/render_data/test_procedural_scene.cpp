@@ -190,14 +190,14 @@ TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
   expect_identical(build(kVariety + "variant: 4\n", 11), build(kVariety + "variant: 4\n", 11));
   // Over 40 seeds every layout, dark and bright, fog on and off; over a dozen, many texture families.
   ProceduralOptions options;
-  options.layout = "random";
+  options.layout = ProceduralLayout::Random;
   options.variety.enabled = true;
   std::set<std::string> layouts, all_families;
   float darkest = 1e9f, brightest = 0;
   int foggy = 0;
   for (uint64_t seed = 1; seed <= 40; ++seed) {
     const ProceduralOptions drawn = draw_variety(options, seed);
-    layouts.insert(drawn.layout);
+    layouts.insert(enum_name(drawn.layout));
     darkest = std::min(darkest, drawn.lighting.ambient);
     brightest = std::max(brightest, drawn.lighting.ambient);
     foggy += drawn.fog.density > 0;
@@ -275,6 +275,9 @@ TEST(ProceduralVariety, BadRangesAreErrorsNamingTheKey) {
   EXPECT_NE(message("{materials: [brick]}").find("did you mean 'bricks'"), std::string::npos);
   EXPECT_NE(message("{layouts: []}").find("needs at least one layout"), std::string::npos);
   EXPECT_NE(message("{layouts: [maze]}").find("one of: room, corridors, hall, arena, outdoor"), std::string::npos);
+  EXPECT_NE(message("{layouts: [rooms]}").find("did you mean 'room'"), std::string::npos);
+  EXPECT_NE(message("{layouts: [room, random]}").find("variety.layouts: random draws from this list"), std::string::npos)
+      << message("{layouts: [room, random]}");
   EXPECT_NE(message("{brightness: [0, 2]}").find("variety.brightness"), std::string::npos);
   EXPECT_NE(message("{fog: 2}").find("variety.fog"), std::string::npos);
 }

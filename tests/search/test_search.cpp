@@ -268,3 +268,31 @@ TEST(SearchOptions, TheFormerSharedOperatorsBlockMovesIntoTheEvolutionBlock) {
   // The random strategy never read them.
   EXPECT_EQ(parse_search("strategy: random\noperators: {mutation_rate: 0.25}\n").strategy.type, "random");
 }
+
+// A candidate's score is written into every history line and distributed reply: the keys, their
+// order and null for an unmeasured latency are the format resumed searches read back.
+TEST(CandidateScore, JsonKeepsTheHistoryLineFormatAndReadsBack) {
+  CandidateScore s;
+  s.val_psnr = 30.5;
+  s.val_ssim = 0.875;
+  s.image_loss = 0.25;
+  s.geometry_loss = 0;
+  s.params = 1234;
+  s.macs = 56789;
+  s.train_seconds = 1.5;
+  EXPECT_EQ(nlohmann::ordered_json(s).dump(),
+            R"({"val_psnr":30.5,"val_ssim":0.875,"image_loss":0.25,"geometry_loss":0.0,"params":1234,"macs":56789,)"
+            R"("latency_ms":null,"train_seconds":1.5})");
+  s.latency_ms = 2.25;
+  const std::string line = nlohmann::ordered_json(s).dump();
+  EXPECT_NE(line.find(R"("macs":56789,"latency_ms":2.25,"train_seconds")"), std::string::npos) << line;
+  const auto back = nlohmann::json::parse(line).get<CandidateScore>();
+  EXPECT_EQ(back.val_psnr, s.val_psnr);
+  EXPECT_EQ(back.params, s.params);
+  EXPECT_EQ(back.latency_ms, s.latency_ms);
+  EXPECT_FALSE(nlohmann::json::parse(R"({"val_psnr":1,"val_ssim":1,"image_loss":0,"geometry_loss":0,"params":1,)"
+                                     R"("macs":1,"latency_ms":null,"train_seconds":0})")
+                   .get<CandidateScore>()
+                   .latency_ms);
+  EXPECT_THROW(nlohmann::json::parse(R"({"val_psnr":1})").get<CandidateScore>(), nlohmann::json::exception);
+}

@@ -17,7 +17,7 @@ namespace {
 
 ArchSpec small_pan() { return spec_from_yaml("backbone: pan\nscale: 2\nblocks: 2\n", "test"); }
 
-TrainSchedule short_schedule(const std::string& layout) {
+TrainSchedule short_schedule(MemoryLayout layout) {
   TrainSchedule s;
   s.steps = 6;
   s.batch_size = 2;
@@ -29,7 +29,7 @@ TrainSchedule short_schedule(const std::string& layout) {
 }
 
 // Trains a fresh small PAN (same seed each time) and returns it with the outcome.
-std::pair<SRNetwork, TrainOutcome> train(const std::string& layout) {
+std::pair<SRNetwork, TrainOutcome> train(MemoryLayout layout) {
   seed_everything(3);
   SRNetwork net(small_pan());
   const Dataset data = Dataset::open(tiny_data());
@@ -42,10 +42,10 @@ std::pair<SRNetwork, TrainOutcome> train(const std::string& layout) {
 
 TEST(Trainer, LayoutsTrainToTheSameWeightsWithinTolerance) {
   set_threads(1);
-  const auto [nchw, nchw_outcome] = train("nchw");
-  const auto [nhwc, nhwc_outcome] = train("nhwc");
-  EXPECT_EQ(nchw_outcome.layout, "nchw");
-  EXPECT_EQ(nhwc_outcome.layout, "nhwc");
+  const auto [nchw, nchw_outcome] = train(MemoryLayout::Nchw);
+  const auto [nhwc, nhwc_outcome] = train(MemoryLayout::Nhwc);
+  EXPECT_EQ(nchw_outcome.layout, MemoryLayout::Nchw);
+  EXPECT_EQ(nhwc_outcome.layout, MemoryLayout::Nhwc);
   const auto a = nchw->parameters(), b = nhwc->parameters();
   ASSERT_EQ(a.size(), b.size());
   double worst = 0;
@@ -61,16 +61,16 @@ TEST(Trainer, LayoutsTrainToTheSameWeightsWithinTolerance) {
 
 TEST(Trainer, SameLayoutAndSeedIsBitIdentical) {
   set_threads(1);
-  const auto [first, first_outcome] = train("nhwc");
-  const auto [second, second_outcome] = train("nhwc");
+  const auto [first, first_outcome] = train(MemoryLayout::Nhwc);
+  const auto [second, second_outcome] = train(MemoryLayout::Nhwc);
   const auto a = first->parameters(), b = second->parameters();
   for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << i;
 }
 
 TEST(Trainer, AutoLayoutRecordsItsChoice) {
   set_threads(1);
-  const auto [net, outcome] = train("auto");
-  EXPECT_TRUE(outcome.layout == "nchw" || outcome.layout == "nhwc") << outcome.layout;
+  const auto [net, outcome] = train(MemoryLayout::Auto);
+  EXPECT_TRUE(outcome.layout == MemoryLayout::Nchw || outcome.layout == MemoryLayout::Nhwc) << enum_name(outcome.layout);
   for (const auto& p : net->parameters()) EXPECT_TRUE(p.is_contiguous());
 }
 
@@ -83,7 +83,7 @@ TEST(Trainer, RenderingInformationPartsLearnAtTheirOwnRate) {
       "backbone: pan\nscale: 2\nblocks: 2\nrit: {enabled: true, channels: [depth, edge], source: hr_fuse}\n", "test"));
   std::vector<std::pair<std::string, torch::Tensor>> before;
   for (const auto& item : net->named_parameters()) before.emplace_back(item.key(), item.value().detach().clone());
-  TrainSchedule schedule = short_schedule("nchw");
+  TrainSchedule schedule = short_schedule(MemoryLayout::Nchw);
   schedule.steps = 1;
   schedule.lr_max = schedule.lr_min = 1e-3;
   schedule.rit_lr_scale = 10;
@@ -123,7 +123,7 @@ bool all_finite(const std::vector<torch::Tensor>& weights) {
 
 // A constant learning rate (no cosine decay), NCHW, `steps` steps.
 TrainSchedule constant_rate(double lr, int steps) {
-  TrainSchedule s = short_schedule("nchw");
+  TrainSchedule s = short_schedule(MemoryLayout::Nchw);
   s.steps = steps;
   s.lr_max = s.lr_min = lr;
   return s;
@@ -249,4 +249,13 @@ TEST(Trainer, ConsecutiveNonFiniteStepsStopTrainingWithAClearError) {
         << what;
     EXPECT_NE(what.find("lr_max"), std::string::npos) << what;
   }
+}
+
+// A train stage's results.json records where the step time went under phase_ms, in this order.
+TEST(Trainer, PhaseTimesKeepTheirJsonFormat) {
+  TrainOutcome o;
+  o.phase_ms = {1.5, 2.5, 3.5, 0.25, 0, 0.125};
+  EXPECT_EQ(to_json(o)["phase_ms"].dump(), R"({"batch":1.5,"forward_and_loss":2.5,"backward_and_clip":3.5,)"
+                                           R"("optimizer":0.25,"validation":0.0,"checkpoint":0.125})");
+  EXPECT_EQ(to_json(o)["layout"], "nchw");
 }
