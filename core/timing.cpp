@@ -15,8 +15,7 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-namespace {
-LatencyStats summarize(const std::vector<double>& ms) {
+LatencyStats summarize_latency(const std::vector<double>& ms) {
   LatencyStats s;
   s.median_ms = median(ms);
   s.min_ms = *std::min_element(ms.begin(), ms.end());
@@ -31,6 +30,8 @@ LatencyStats summarize(const std::vector<double>& ms) {
   s.runs = static_cast<int>(ms.size());
   return s;
 }
+
+namespace {
 
 double time_ms(const std::function<void()>& run) {
   const auto start = std::chrono::steady_clock::now();
@@ -51,7 +52,7 @@ std::vector<LatencyStats> measure_latency_interleaved(const std::vector<std::fun
   for (int r = 0; r < std::max(1, rounds); ++r)
     for (size_t t = 0; t < runs.size(); ++t) ms[t].push_back(time_ms(runs[t]));
   std::vector<LatencyStats> out;
-  for (const auto& m : ms) out.push_back(summarize(m));
+  for (const auto& m : ms) out.push_back(summarize_latency(m));
   return out;
 }
 

@@ -13,6 +13,9 @@ struct LatencyStats {
   int runs = 0;
 };
 
+// Median, min, max, mean and p95 of measured times (ms); an Error when there are none.
+LatencyStats summarize_latency(const std::vector<double>& ms);
+
 LatencyStats measure_latency(const std::function<void()>& run, int warmup = 2, int runs = 10);
 
 // Several targets timed in interleaved rounds (one run of each per round, after `warmup` runs

@@ -109,10 +109,7 @@ BenchResult time_onnx(const BenchOptions& options) {
   r.target.runtime = "onnxruntime";
   r.target.detail = "ORT " + runner.version();
   r.target.macs = complexity(*source.network, w, h).macs * options.batch;
-  r.latency.median_ms = median(ms);
-  r.latency.min_ms = *std::min_element(ms.begin(), ms.end());
-  r.latency.max_ms = *std::max_element(ms.begin(), ms.end());
-  r.latency.runs = static_cast<int>(ms.size());
+  r.latency = summarize_latency(ms);
   r.gflops = r.latency.median_ms > 0 ? 2.0 * static_cast<double>(r.target.macs) / (r.latency.median_ms * 1e6) : 0.0;
   return r;
 }

@@ -218,13 +218,7 @@ void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<st
   spdlog::info("timing {} exported models in ONNX Runtime ({} runs each)", jobs.size(), runs);
   const auto results = OnnxRuntimeRunner().run_checked(jobs);
   for (size_t k = 0; k < rows.size(); ++k) {
-    const auto& ms = results[k].runs.at(0).times_ms;
-    LatencyStats stats;
-    stats.median_ms = median(ms);
-    stats.min_ms = *std::min_element(ms.begin(), ms.end());
-    stats.max_ms = *std::max_element(ms.begin(), ms.end());
-    stats.runs = static_cast<int>(ms.size());
-    evaluations[rows[k]].onnxruntime_latency = stats;
+    evaluations[rows[k]].onnxruntime_latency = summarize_latency(results[k].runs.at(0).times_ms);
   }
 }
 }  // namespace

@@ -68,7 +68,9 @@ TEST(ImportanceMethods, OneRegistryScoresEveryUnitGroup) {
         ASSERT_TRUE(scores.count(u.groups[g]));
         EXPECT_EQ(scores.at(u.groups[g]).numel(), u.widths[g]);
         EXPECT_TRUE(torch::isfinite(scores.at(u.groups[g])).all().item<bool>());
-        if (name == "magnitude") EXPECT_TRUE(torch::allclose(scores.at(u.groups[g]), reference.at(u.groups[g])));
+        if (name == "magnitude") {
+          EXPECT_TRUE(torch::allclose(scores.at(u.groups[g]), reference.at(u.groups[g])));
+        }
       }
   }
 }

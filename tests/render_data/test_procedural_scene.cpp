@@ -252,7 +252,9 @@ TEST(ProceduralVariety, EveryLayoutHasAWalkableCameraPath) {
       }
       EXPECT_EQ(ceiling, layout != "arena" && layout != "outdoor");
       EXPECT_EQ(skyline, layout == "outdoor");
-      if (layout == "hall") EXPECT_TRUE(columns);
+      if (layout == "hall") {
+        EXPECT_TRUE(columns);
+      }
     }
   // Without variety, the new layouts build too (fixed materials).
   expect_camera_in_free_space(build("type: procedural\nlayout: hall\nsize: [10, 9]\nheight: 8\ntexture_size: 32\n", 2), "hall");
