@@ -18,29 +18,26 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#define CGSR_JSON_FIELDS(Type, ...)                                                                               \
-  template <class BasicJsonType,                                                                                  \
-            nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<BasicJsonType>::value, int> = 0>       \
-  void to_json(BasicJsonType& nlohmann_json_j, const Type& nlohmann_json_t) {                                     \
-    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_TO, __VA_ARGS__))                                      \
-  }                                                                                                               \
-  template <class BasicJsonType,                                                                                  \
-            nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<BasicJsonType>::value, int> = 0>       \
-  void from_json(const BasicJsonType& nlohmann_json_j, Type& nlohmann_json_t) {                                   \
-    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_FROM, __VA_ARGS__))                                    \
+// Internal: the template head (every basic_json: json, ordered_json) and the shared to_json.
+#define CGSR_JSON_DETAIL_TEMPLATE                                                                          \
+  template <class BasicJsonType,                                                                           \
+            nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<BasicJsonType>::value, int> = 0>
+#define CGSR_JSON_DETAIL_TO(Type, ...)                                                                     \
+  CGSR_JSON_DETAIL_TEMPLATE void to_json(BasicJsonType& nlohmann_json_j, const Type& nlohmann_json_t) {    \
+    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_TO, __VA_ARGS__))                               \
   }
 
-#define CGSR_JSON_FIELDS_WITH_DEFAULT(Type, ...)                                                                  \
-  template <class BasicJsonType,                                                                                  \
-            nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<BasicJsonType>::value, int> = 0>       \
-  void to_json(BasicJsonType& nlohmann_json_j, const Type& nlohmann_json_t) {                                     \
-    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_TO, __VA_ARGS__))                                      \
-  }                                                                                                               \
-  template <class BasicJsonType,                                                                                  \
-            nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<BasicJsonType>::value, int> = 0>       \
-  void from_json(const BasicJsonType& nlohmann_json_j, Type& nlohmann_json_t) {                                   \
-    const Type nlohmann_json_default_obj{};                                                                       \
-    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_FROM_WITH_DEFAULT, __VA_ARGS__))                       \
+#define CGSR_JSON_FIELDS(Type, ...)                                                                        \
+  CGSR_JSON_DETAIL_TO(Type, __VA_ARGS__)                                                                   \
+  CGSR_JSON_DETAIL_TEMPLATE void from_json(const BasicJsonType& nlohmann_json_j, Type& nlohmann_json_t) {  \
+    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_FROM, __VA_ARGS__))                             \
+  }
+
+#define CGSR_JSON_FIELDS_WITH_DEFAULT(Type, ...)                                                           \
+  CGSR_JSON_DETAIL_TO(Type, __VA_ARGS__)                                                                   \
+  CGSR_JSON_DETAIL_TEMPLATE void from_json(const BasicJsonType& nlohmann_json_j, Type& nlohmann_json_t) {  \
+    const Type nlohmann_json_default_obj{};                                                                \
+    NLOHMANN_JSON_EXPAND(NLOHMANN_JSON_PASTE(NLOHMANN_JSON_FROM_WITH_DEFAULT, __VA_ARGS__))                \
   }
 
 // std::optional<T> as null or its value (nlohmann-json 3.11 has no serializer for it).

@@ -213,10 +213,10 @@ struct Job {
   std::string name;
   Camera camera;  // its keys sit at the top level of a job
 };
-Schema<Job> job_schema() {
+Schema<Job> job_schema(const Schema<Camera>& camera = camera_schema()) {
   Schema<Job> s;
   s.field("name", &Job::name, "job name");
-  s.inline_section(&Job::camera, camera_schema());
+  s.inline_section(&Job::camera, camera);
   s.moved_block("camera");
   return s;
 }
@@ -260,14 +260,10 @@ TEST(Config, AnInlineSectionReadsAtTheTopAndItsFormerBlockStillReads) {
 }
 
 namespace {
-// A lens whose field of view was once `angle` (an older shape, upgraded with a warning), inlined
-// into a shot: the upgrade must reach the shot's top level, where the lens keys now sit.
-struct Lens {
-  double fov = 60.0;
-};
-Schema<Lens> lens_schema() {
-  Schema<Lens> s;
-  s.field("fov", &Lens::fov, "vertical field of view in degrees").range(1, 179);
+// A camera whose field of view was once `angle` (an older shape, upgraded with a warning),
+// inlined into a job: the upgrade must reach the job's top level, where the camera keys now sit.
+Schema<Camera> camera_schema_with_former_angle() {
+  Schema<Camera> s = camera_schema();
   s.upgrade([](const YAML::Node& map, const Cursor& at) {
     if (!map || !map.IsMap() || !map["angle"]) return map;
     warn_deprecated(at.doc ? at.doc->locate(map["angle"]) : at.path,
@@ -278,43 +274,33 @@ Schema<Lens> lens_schema() {
   });
   return s;
 }
-struct Shot {
-  std::string name;
-  Lens lens;  // its keys sit at the top level of a shot
-};
-Schema<Shot> shot_schema() {
-  Schema<Shot> s;
-  s.field("name", &Shot::name, "shot name");
-  s.inline_section(&Shot::lens, lens_schema());
-  s.moved_block("lens");
-  return s;
-}
 }  // namespace
 
 TEST(Config, AnInlineSectionCarriesItsSchemasUpgrades) {
+  const Schema<Job> schema = job_schema(camera_schema_with_former_angle());
   std::ostringstream log;
   auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
   spdlog::default_logger()->sinks().push_back(sink);
-  const Shot flat = parse_document(Document::parse("name: a\nangle: 30\n", "shot.yaml"), shot_schema());
+  const Job flat = parse_document(Document::parse("name: a\nangle: 30\n", "new-job.yaml"), schema);
   // The same old key inside the section's former block: lifted first, then upgraded.
-  const Shot nested = parse_document(Document::parse("name: b\nlens: {angle: 40}\n", "old-shot.yaml"), shot_schema());
+  const Job nested = parse_document(Document::parse("name: b\ncamera: {angle: 40}\n", "old-job.yaml"), schema);
   spdlog::default_logger()->sinks().pop_back();
-  EXPECT_DOUBLE_EQ(flat.lens.fov, 30);
-  EXPECT_DOUBLE_EQ(nested.lens.fov, 40);
+  EXPECT_DOUBLE_EQ(flat.camera.fov, 30);
+  EXPECT_DOUBLE_EQ(nested.camera.fov, 40);
   const std::string warning = log.str();
-  EXPECT_NE(warning.find("shot.yaml:2:8: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
-  EXPECT_NE(warning.find("old-shot.yaml:2:15: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
-  EXPECT_NE(warning.find("old-shot.yaml:2:1: 'lens' is deprecated"), std::string::npos) << warning;
-  // Emitted in the current shape, which reads back without a warning.
-  const std::string emitted = to_yaml(shot_schema().emit(flat));
+  EXPECT_NE(warning.find("new-job.yaml:2:8: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("old-job.yaml:2:17: 'angle' is deprecated: write 'fov'"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("old-job.yaml:2:1: 'camera' is deprecated"), std::string::npos) << warning;
+  // Emitted in the current shape.
+  const std::string emitted = to_yaml(schema.emit(flat));
   EXPECT_EQ(emitted.find("angle"), std::string::npos) << emitted;
   EXPECT_NE(emitted.find("fov: 30"), std::string::npos) << emitted;
   // The upgraded key is checked like a current one, at the old key's value.
   try {
-    parse_document(Document::parse("angle: 300\n", "shot.yaml"), shot_schema());
+    parse_document(Document::parse("angle: 300\n", "new-job.yaml"), schema);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("shot.yaml:1:8: fov: must be in [1, 179]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("new-job.yaml:1:8: fov: must be in [1, 179]"), std::string::npos) << e.what();
   }
 }
 

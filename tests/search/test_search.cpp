@@ -272,14 +272,8 @@ TEST(SearchOptions, TheFormerSharedOperatorsBlockMovesIntoTheEvolutionBlock) {
 // A candidate's score is written into every history line and distributed reply: the keys, their
 // order and null for an unmeasured latency are the format resumed searches read back.
 TEST(CandidateScore, JsonKeepsTheHistoryLineFormatAndReadsBack) {
-  CandidateScore s;
-  s.val_psnr = 30.5;
-  s.val_ssim = 0.875;
-  s.image_loss = 0.25;
-  s.geometry_loss = 0;
-  s.params = 1234;
-  s.macs = 56789;
-  s.train_seconds = 1.5;
+  CandidateScore s{/*val_psnr=*/30.5, /*val_ssim=*/0.875, /*image_loss=*/0.25, /*geometry_loss=*/0,
+                   /*params=*/1234,  /*macs=*/56789,     /*latency_ms=*/std::nullopt, /*train_seconds=*/1.5};
   EXPECT_EQ(nlohmann::ordered_json(s).dump(),
             R"({"val_psnr":30.5,"val_ssim":0.875,"image_loss":0.25,"geometry_loss":0.0,"params":1234,"macs":56789,)"
             R"("latency_ms":null,"train_seconds":1.5})");
