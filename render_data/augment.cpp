@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <cmath>
+
 #include "core/error.h"
 
 namespace cgsr {
@@ -9,6 +11,21 @@ namespace cgsr {
 Augmentation Augmentation::from_index(int index) {
   CGSR_CHECK(index >= 0 && index < 8, "augmentation index must be in [0, 8)");
   return {index >= 4, index % 4};
+}
+
+ColorAugmentation ColorAugmentation::from_uniform(double u_permutation, double u_gain) {
+  CGSR_CHECK(u_permutation >= 0 && u_permutation < 1 && u_gain >= 0 && u_gain < 1, "uniform draws must be in [0, 1)");
+  return {static_cast<int>(u_permutation * 6), static_cast<float>(std::pow(kMaxGain, 2 * u_gain - 1))};
+}
+
+torch::Tensor augment_color(const torch::Tensor& color, const ColorAugmentation& a) {
+  static constexpr int64_t kOrders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  CGSR_CHECK(a.permutation >= 0 && a.permutation < 6, "colour permutation index must be in [0, 6)");
+  const int64_t cdim = color.dim() - 3;
+  CGSR_CHECK(color.size(cdim) == 3, "colour augmentation needs 3 colour channels");
+  const auto& order = kOrders[a.permutation];
+  torch::Tensor t = a.permutation ? color.index_select(cdim, torch::tensor({order[0], order[1], order[2]})) : color;
+  return a.gain == 1.0f ? t.contiguous() : t.mul(a.gain).clamp_(0, 1);
 }
 
 torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a) {

@@ -21,9 +21,23 @@ struct Augmentation {
   static Augmentation from_index(int index);  // 0..7
 };
 
+// A colour change applied alike to an item's LR and HR colour (not to its rendering information):
+// the colour channels reordered and scaled by one gain, clamped to [0, 1]. Rendered colour is
+// albedo times light per channel, so a permuted or brighter scene is another plausible one: a
+// network trained on one level's palette and brightness then sees others.
+struct ColorAugmentation {
+  int permutation = 0;  // 0..5: one of the 6 orders of R, G, B (0 keeps it)
+  float gain = 1.0f;
+  static constexpr float kMaxGain = 1.6f;  // gains are drawn log-uniformly in [1/kMaxGain, kMaxGain]
+  // From two uniform draws in [0, 1).
+  static ColorAugmentation from_uniform(double u_permutation, double u_gain);
+};
+
 // `image`: [C,H,W] or [N,C,H,W] with channels that move only (colour, depth, edges, ...).
 torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a);
 // `info`: [C,H,W] or [N,C,H,W] stacked in the order of `channels` (render_channels.h).
+// `color`: [3,H,W] or [N,3,H,W] in [0, 1].
+torch::Tensor augment_color(const torch::Tensor& color, const ColorAugmentation& a);
 torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderChannel>& channels, const Augmentation& a);
 
 }  // namespace cgsr

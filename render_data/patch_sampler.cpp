@@ -30,6 +30,11 @@ std::pair<size_t, size_t> resolution_pair(const Dataset& data, int scale, int lr
 
 namespace {
 
+template <class Rng>
+double uniform01(Rng& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;  // [0, 1): the top 53 bits
+}
+
 // Both resolutions must carry every channel a batch needs.
 void require_channels(const Dataset& data, const std::vector<RenderChannel>& channels, size_t lo, size_t hi) {
   for (size_t r : {lo, hi}) {
@@ -49,7 +54,7 @@ struct Item {
 
 Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int s,
                const std::vector<RenderChannel>& channels, DepthEncoding depth, double near_plane, double far_plane,
-               const Augmentation* aug) {
+               const Augmentation* aug, const ColorAugmentation* color = nullptr) {
   const Frame l = crop(lr, x, y, w, h), H = crop(hr, s * x, s * y, s * w, s * h);
   Item it;
   it.lr_color = l.color_float();
@@ -61,6 +66,10 @@ Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int
     it.hr_color = augment_image(it.hr_color, *aug);
     it.lr_info = augment_info(it.lr_info, channels, *aug);
     it.hr_info = augment_info(it.hr_info, channels, *aug);
+  }
+  if (color) {
+    it.lr_color = augment_color(it.lr_color, *color);
+    it.hr_color = augment_color(it.hr_color, *color);
   }
   return it;
 }
@@ -149,6 +158,7 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
   // Draw every item's choices first from one stream: the batch depends only on (seed, k).
   struct Choice {
     int frame, x, y, aug;
+    ColorAugmentation color;
   };
   std::vector<Choice> choices(o.batch_size);
   auto rng = make_rng("patch-sampler", o.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(k));
@@ -156,7 +166,7 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
     if (scene_frames_.empty()) {
       c.frame = frames_[rng() % frames_.size()];
     } else {
-      const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;  // [0, 1)
+      const double u = uniform01(rng);
       const size_t s = std::upper_bound(scene_cumulative_.begin(), scene_cumulative_.end(), u) - scene_cumulative_.begin();
       const auto& mine = scene_frames_[std::min(s, scene_frames_.size() - 1)];
       c.frame = mine[rng() % mine.size()];
@@ -165,6 +175,15 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
     c.y = static_cast<int>(rng() % static_cast<uint64_t>(lr.height - o.patch_size + 1));
     c.aug = o.augment ? static_cast<int>(rng() % 8) : 0;
   }
+  // Colours from a stream of their own: with or without them, a batch has the same windows, so
+  // colour augmentation is compared with its control on the same patches.
+  if (o.color_augment) {
+    auto colour_rng = make_rng("patch-colour", o.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(k));
+    for (auto& c : choices) {
+      const double u_permutation = uniform01(colour_rng);
+      c.color = ColorAugmentation::from_uniform(u_permutation, uniform01(colour_rng));
+    }
+  }
   std::vector<Item> items(o.batch_size);
   const auto make_one = [&](int i) {
     const Choice& c = choices[i];
@@ -172,7 +191,8 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
     const Augmentation aug = Augmentation::from_index(c.aug);
     const SceneInfo& scene = data_.scene_of(c.frame);  // depth is encoded with its scene's planes
     items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
-                         scene.near_plane, scene.far_plane, o.augment ? &aug : nullptr);
+                         scene.near_plane, scene.far_plane, o.augment ? &aug : nullptr,
+                         o.color_augment ? &c.color : nullptr);
   };
   if (parallel) {
     tbb::parallel_for(0, o.batch_size, make_one);

@@ -17,7 +17,8 @@
 // the split), a random LR window, the HR window exactly `scale` times
 // it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), DESIGN.md). With
 // augment, each item gets one of the 8 flips/rotations, applied to every tensor; normals and
-// motion vectors are rotated/flipped as vectors (augment.h). Batch k depends only on the seed
+// motion vectors are rotated/flipped as vectors (augment.h); with color_augment, its LR and HR
+// colour also get one colour permutation and gain. Batch k depends only on the seed
 // and k (not on threads or timing), so a resumed training run sees the same data; batches are
 // built in the background (TBB), `prefetch` ahead of the last one asked for (or, with prefetch
 // 0, on the calling thread when asked for).
@@ -39,6 +40,7 @@ struct PatchSamplerOptions {
   std::vector<RenderChannel> channels;  // rendering information in the batch (may be empty)
   DepthEncoding depth_encoding = DepthEncoding::Log;  // of the depth channel (the reader's, e.g. the model's)
   bool augment = true;
+  bool color_augment = false;  // colour channels permuted and scaled alike in LR and HR (augment.h)
   uint64_t seed = 0;
   // Batches built ahead on TBB threads; 0: each batch is built when asked for, on the calling
   // thread alone (no other thread runs while the caller's compute threads may own every core).

@@ -29,6 +29,8 @@ config::Schema<TrainSchedule> schedule_schema() {
       .range(1e-3, 1e3);
   s.field("clip_grad_norm", &TrainSchedule::clip_grad_norm, "gradient norm limit (0 = no clipping)").at_least(0);
   s.field("augment", &TrainSchedule::augment, "random flips and 90 degree rotations");
+  s.field("color_augment", &TrainSchedule::color_augment,
+          "random colour-channel orders and brightness gains, alike in LR and HR colour");
   s.field("validate_every", &TrainSchedule::validate_every, "steps between validations (0 = at the end)").at_least(0);
   s.field("val_frames", &TrainSchedule::val_frames, "validation frames (0 = the whole split)").at_least(0);
   s.field("checkpoint_every", &TrainSchedule::checkpoint_every, "steps between checkpoints").at_least(1);
@@ -44,6 +46,7 @@ config::Schema<TrainSchedule> schedule_schema() {
   // Left out of the written config at its default, so stage hashes of earlier runs hold (the
   // batches are the same either way).
   s.omit_when("prefetch", [](const TrainSchedule& t) { return t.prefetch == 2; });
+  s.omit_when("color_augment", [](const TrainSchedule& t) { return !t.color_augment; });
   s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
     if (t.lr_min > t.lr_max) at.child("lr_min").fail(node["lr_min"] ? node["lr_min"] : node, "must not exceed lr_max");
   });
@@ -369,6 +372,7 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.channels = channels_;
   sampling.depth_encoding = network_->depth_encoding();
   sampling.augment = schedule_.augment;
+  sampling.color_augment = schedule_.color_augment;
   sampling.prefetch = schedule_.prefetch;
   PatchSampler sampler(data_, sampling);
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).

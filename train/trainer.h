@@ -43,6 +43,7 @@ struct TrainSchedule {
   double rit_lr_scale = 1.0;
   double clip_grad_norm = 1.0;  // 0 disables clipping
   bool augment = true;          // flips and 90 degree rotations
+  bool color_augment = false;   // colour permutations and gains (render_data/augment.h)
   int validate_every = 250;     // steps; 0 = only at the end
   int val_frames = 8;           // validation frames (spread over the split); 0 = all
   int checkpoint_every = 100;   // steps

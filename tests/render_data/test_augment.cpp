@@ -1,8 +1,10 @@
-// Flips and rotations move pixels and transform normal and motion vectors consistently.
+// Flips and rotations move pixels and transform normal and motion vectors consistently; colour
+// augmentation reorders and scales colour channels only.
 #include <gtest/gtest.h>
 
 #include <torch/torch.h>
 
+#include "core/error.h"
 #include "render_data/augment.h"
 #include "render_data/derive_channels.h"
 #include "render_data/vec_math.h"
@@ -73,6 +75,27 @@ TEST(Augment, HorizontalFlipNegatesXComponentsOnly) {
   // Batched input works the same.
   EXPECT_TRUE(torch::allclose(augment_info(info.unsqueeze(0), ch, Augmentation{true, 1})[0],
                               augment_info(info, ch, Augmentation{true, 1})));
+}
+
+TEST(Augment, ColourDrawsCoverEveryOrderAndTheGainRangeSymmetrically) {
+  const float m = ColorAugmentation::kMaxGain;
+  EXPECT_EQ(ColorAugmentation::from_uniform(0, 0).permutation, 0);
+  EXPECT_EQ(ColorAugmentation::from_uniform(0.999, 0).permutation, 5);
+  EXPECT_FLOAT_EQ(ColorAugmentation::from_uniform(0, 0).gain, 1 / m);
+  EXPECT_FLOAT_EQ(ColorAugmentation::from_uniform(0, 0.5).gain, 1.0f);  // log-uniform: 1 in the middle
+  EXPECT_NEAR(ColorAugmentation::from_uniform(0, 0.999999).gain, m, 1e-5);
+  EXPECT_THROW(ColorAugmentation::from_uniform(1.0, 0), Error);
+}
+
+TEST(Augment, ColourReordersAndScalesChannelsWithinZeroToOne) {
+  auto color = torch::rand({2, 3, 5, 4});
+  // Order 3 is (G, B, R); a gain of 1.5 saturates what was above 2/3.
+  const auto out = augment_color(color, ColorAugmentation{3, 1.5f});
+  const auto expected = torch::stack({color.select(1, 1), color.select(1, 2), color.select(1, 0)}, 1).mul(1.5f).clamp(0, 1);
+  EXPECT_TRUE(torch::allclose(out, expected));
+  EXPECT_LE(out.max().item<float>(), 1.0f);
+  EXPECT_TRUE(torch::equal(augment_color(color[0], ColorAugmentation{}), color[0]));  // the identity
+  EXPECT_THROW(augment_color(torch::rand({4, 5, 4}), ColorAugmentation{1, 1.0f}), Error);  // not RGB
 }
 
 }  // namespace

@@ -83,6 +83,30 @@ TEST(PatchSampler, PatchesAreAlignedAndAugmentedConsistently) {
   }
 }
 
+// Colour augmentation changes LR and HR colour alike (still aligned) and nothing else: the same
+// windows, flips and rendering information as without it.
+TEST(PatchSampler, ColourAugmentationChangesOnlyColourAndKeepsItAligned) {
+  const Dataset data = Dataset::open(synthetic_dataset());
+  PatchSamplerOptions o;
+  o.patch_size = 10;
+  o.batch_size = 6;
+  o.channels = kAll;
+  o.seed = 5;
+  PatchSampler plain(data, o);
+  o.color_augment = true;
+  PatchSampler coloured(data, o);
+  for (int k = 0; k < 3; ++k) {
+    const Batch p = plain.next(), c = coloured.next();
+    EXPECT_EQ(c.frames, p.frames);
+    EXPECT_TRUE(torch::equal(c.lr_info, p.lr_info));
+    EXPECT_TRUE(torch::equal(c.hr_info, p.hr_info));
+    EXPECT_TRUE(torch::equal(c.hr_color.slice(2, 0, 20, 2).slice(3, 0, 20, 2), c.lr_color));
+    EXPECT_FALSE(torch::equal(c.lr_color, p.lr_color));
+    EXPECT_GE(c.lr_color.min().item<float>(), 0.0f);
+    EXPECT_LE(c.lr_color.max().item<float>(), 1.0f);
+  }
+}
+
 TEST(PatchSampler, DeterministicUnderTheSeedAndIndexable) {
   const Dataset data = Dataset::open(synthetic_dataset());
   PatchSamplerOptions o;
