@@ -54,14 +54,18 @@ const fs::path& synthetic_dataset() {
 const std::vector<RenderChannel> kAll = {RenderChannel::Depth, RenderChannel::Normal, RenderChannel::NormalAngle,
                                          RenderChannel::Edge, RenderChannel::Motion};
 
+PatchSamplerOptions all_channels(int patch_size, int batch_size, uint64_t seed) {
+  PatchSamplerOptions o;
+  o.patch_size = patch_size;
+  o.batch_size = batch_size;
+  o.channels = kAll;
+  o.seed = seed;
+  return o;
+}
+
 TEST(PatchSampler, PatchesAreAlignedAndAugmentedConsistently) {
   const Dataset data = Dataset::open(synthetic_dataset());
-  PatchSamplerOptions o;
-  o.patch_size = 12;
-  o.batch_size = 8;
-  o.channels = kAll;
-  o.seed = 3;
-  PatchSampler sampler(data, o);
+  PatchSampler sampler(data, all_channels(12, 8, 3));
   for (int k = 0; k < 4; ++k) {
     const Batch b = sampler.next();
     ASSERT_EQ(b.lr_color.sizes(), (std::vector<int64_t>{8, 3, 12, 12}));
@@ -87,11 +91,7 @@ TEST(PatchSampler, PatchesAreAlignedAndAugmentedConsistently) {
 // windows, flips and rendering information as without it.
 TEST(PatchSampler, ColourAugmentationChangesOnlyColourAndKeepsItAligned) {
   const Dataset data = Dataset::open(synthetic_dataset());
-  PatchSamplerOptions o;
-  o.patch_size = 10;
-  o.batch_size = 6;
-  o.channels = kAll;
-  o.seed = 5;
+  PatchSamplerOptions o = all_channels(10, 6, 5);
   PatchSampler plain(data, o);
   o.color_augment = true;
   PatchSampler coloured(data, o);
