@@ -6,6 +6,7 @@
 // A horizontal flip negates motion x and normal x; a vertical flip negates motion y and normal
 // y; a 90-degree counter-clockwise rotation (as displayed) maps motion (dx, dy) -> (dy, -dx) and
 // normal (x, y) -> (-y, x). Depth, normal angle, edges and colour only move.
+// Colour augmentation (ColorAugmentation below) changes colour values, never geometry.
 
 #include <torch/types.h>
 
@@ -36,8 +37,9 @@ struct ColorAugmentation {
 // `image`: [C,H,W] or [N,C,H,W] with channels that move only (colour, depth, edges, ...).
 torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a);
 // `info`: [C,H,W] or [N,C,H,W] stacked in the order of `channels` (render_channels.h).
+torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderChannel>& channels, const Augmentation& a);
+
 // `color`: [3,H,W] or [N,3,H,W] in [0, 1].
 torch::Tensor augment_color(const torch::Tensor& color, const ColorAugmentation& a);
-torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderChannel>& channels, const Augmentation& a);
 
 }  // namespace cgsr

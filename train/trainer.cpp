@@ -46,6 +46,7 @@ config::Schema<TrainSchedule> schedule_schema() {
   // Left out of the written config at its default, so stage hashes of earlier runs hold (the
   // batches are the same either way).
   s.omit_when("prefetch", [](const TrainSchedule& t) { return t.prefetch == 2; });
+  // Off, it is left out too, so stage hashes made before it existed hold.
   s.omit_when("color_augment", [](const TrainSchedule& t) { return !t.color_augment; });
   s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
     if (t.lr_min > t.lr_max) at.child("lr_min").fail(node["lr_min"] ? node["lr_min"] : node, "must not exceed lr_max");
