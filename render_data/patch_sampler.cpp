@@ -180,7 +180,7 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
   if (o.color_augment) {
     auto colour_rng = make_rng("patch-colour", o.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(k));
     for (auto& c : choices) {
-      const double u_permutation = uniform01(colour_rng);
+      const double u_permutation = uniform01(colour_rng);  // drawn first: argument order is unspecified
       c.color = ColorAugmentation::from_uniform(u_permutation, uniform01(colour_rng));
     }
   }
