@@ -462,7 +462,7 @@ class Pipeline {
 
   // One table and plot of every model. The stages timed their models minutes or hours apart,
   // under whatever else the machine was doing then; the report times them again side by side, in
-  // interleaved rounds over the test frames in turn, so that their latencies compare. The
+  // interleaved rounds over the evaluated frames in turn, so that their latencies compare. The
   // held-out scenes' rows join untimed.
   void report() {
     const std::vector<std::string> runs = {(stages_.dir("eval") / "results.json").string(),
@@ -508,8 +508,9 @@ class Pipeline {
     std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
     std::vector<Batch> frames;              // per model, the first of them
     std::vector<std::function<void()>> timed;
-    const std::vector<int> test_frames =
-        data_->frames(Split::Test).empty() ? std::vector<int>{0} : data_->frames(Split::Test);
+    // The frames the rows were evaluated on (of a scene set, e.g. one scene's), not the whole split:
+    // a hybrid's latency follows the patterns its frames choose.
+    const std::vector<int> test_frames = evaluation_frames(*data_, eval_);
     for (const auto& e : evaluations) {
       const auto file = files.find(e.name);
       if (e.name == roles_.static_network.name)
