@@ -270,6 +270,24 @@ Dataset Dataset::scene(const std::string& name) const {
   throw Error(info().root.string(), "has no scene '" + name + "'" + did_you_mean(name, names) + " (scenes: " + join(names) + ")");
 }
 
+Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>& channels) {
+  const Dataset all = Dataset::open(path);
+  const auto& available = all.info().channels;
+  std::vector<RenderChannel> needed;
+  const auto need = [&](RenderChannel c) {
+    if (std::find(needed.begin(), needed.end(), c) == needed.end() &&
+        std::find(available.begin(), available.end(), c) != available.end())
+      needed.push_back(c);
+  };
+  for (auto c : channels) need(c);
+  need(RenderChannel::Edge);
+  std::sort(needed.begin(), needed.end());
+  DatasetOpenOptions open;
+  open.channels = channel_names(needed);
+  if (open.channels.empty()) return all;  // no edge map either: every channel it has
+  return Dataset::open(path, open);
+}
+
 std::vector<int> spread_frames(const std::vector<int>& frames, int count) {
   if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
   std::vector<int> out;

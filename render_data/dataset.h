@@ -123,6 +123,12 @@ class Dataset {
 // At most `count` frames spread evenly over `frames`, in order (count <= 0: all of them).
 std::vector<int> spread_frames(const std::vector<int>& frames, int count);
 
+// The data set at `path` loading only `channels` of its rendering information (those it has) and
+// the edge map (the smallest channel; an empty list would mean all): decoding the other G-buffers,
+// motion above all, costs more than the work on a frame, and on a large set a frame cache full of
+// them overflows and decodes frames over and over.
+Dataset open_for_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
+
 // Loader entry points (dataset.cpp registers them).
 std::unique_ptr<FrameSource> open_cgsr_dataset(const std::filesystem::path& root, const DatasetOpenOptions& options);
 std::unique_ptr<FrameSource> open_cgsr_release(const std::filesystem::path& root, const DatasetOpenOptions& options);

@@ -67,23 +67,11 @@ namespace {
 // temporal error and edges for the PSNR on geometry edges (evaluate() reads them at HR):
 // decoding a 1080p frame's other G-buffers would cost more than the metrics.
 Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upscaler>>& upscalers, bool temporal) {
-  const Dataset all = Dataset::open(path);
-  const auto& available = all.info().channels;
   std::vector<RenderChannel> needed;
-  const auto need = [&](RenderChannel c) {
-    if (std::find(needed.begin(), needed.end(), c) == needed.end() &&
-        std::find(available.begin(), available.end(), c) != available.end())
-      needed.push_back(c);
-  };
   for (const auto& u : upscalers)
-    for (auto c : u->channels()) need(c);
-  if (temporal) need(RenderChannel::Motion);
-  need(RenderChannel::Edge);
-  std::sort(needed.begin(), needed.end());
-  DatasetOpenOptions open;
-  open.channels = channel_names(needed);
-  if (open.channels.empty()) return all;  // an empty list means "all channels"
-  return Dataset::open(path, open);
+    for (auto c : u->channels()) needed.push_back(c);
+  if (temporal) needed.push_back(RenderChannel::Motion);
+  return open_for_channels(path, needed);
 }
 }  // namespace
 

@@ -102,7 +102,6 @@ void write_loss_curve(const std::filesystem::path& path, const TrainOutcome& out
 }  // namespace
 
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
-  const Dataset data = Dataset::open(options.data);
   ModelSource source = resolve_model(options.model, options.scale);
   SRNetwork network = source.network;
   std::string stage = "backbone";
@@ -114,6 +113,8 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
     network = inherit(*source.network, resolve_spec(child)).network;
     stage = "cg-enhanced";
   }
+  // Only what the network reads (its geometry targets are the same channels at HR).
+  const Dataset data = open_for_channels(options.data, network->input_channels());
   const std::string name = options.name.empty() ? spec_summary(network->spec()) : options.name;
   spdlog::info("training {} on {} ({} train / {} val frames)", name, data.info().root.string(),
                data.frames(Split::Train).size(), data.frames(Split::Val).size());
