@@ -1,6 +1,7 @@
 #include "cli/commands/prune.h"
 
 #include "core/yaml_json.h"
+#include "models/model_file.h"
 #include "render_data/dataset.h"
 
 namespace cgsr::cli {
@@ -34,7 +35,10 @@ void setup_prune(CLI::App& app) {
 }
 
 nlohmann::ordered_json run_prune(const PruneCommandOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
-  const Dataset data = Dataset::open(options.data);
+  // What the network and the dynamic pruning component's sampler read, nothing more.
+  std::vector<RenderChannel> channels = read_model_file(options.model).spec.input_channels();
+  for (auto c : options.sampler.render_channels()) channels.push_back(c);
+  const Dataset data = open_for_channels(options.data, channels);
   return prune(options.model, data, options, run_dir.path(), options.resume, yaml_to_json(resolved));
 }
 

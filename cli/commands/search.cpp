@@ -110,8 +110,9 @@ void write_population_plot(const std::filesystem::path& path, const SearchResult
 
 nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
                                           RunDir& run_dir) {
-  const Dataset data = Dataset::open(options.data);
   Model parent = load_model(options.parent);
+  // Candidates read a subset of the parent's channels (their geometry targets too, at HR).
+  const Dataset data = open_for_channels(options.data, parent.network->input_channels());
   if (!parent.network->has_rit())
     spdlog::warn("{}: the parent has no RIT block; the search runs on the plain backbone", options.parent);
 

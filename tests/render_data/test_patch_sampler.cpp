@@ -202,5 +202,20 @@ TEST(Dataset, CacheStaysWithinItsBudget) {
   EXPECT_TRUE(torch::equal(data.frame(0, 1)->color, data.load(0, 1).color));
 }
 
+TEST(Dataset, OpenForChannelsLoadsWhatIsNamedAndTheEdgeMap) {
+  const Dataset narrow = open_for_channels(synthetic_dataset(), {RenderChannel::Depth, RenderChannel::Depth});
+  const auto frame = narrow.frame(0, 1);
+  EXPECT_EQ(frame->channels(), (std::vector<RenderChannel>{RenderChannel::Depth, RenderChannel::Edge}));
+  const auto full = Dataset::open(synthetic_dataset()).frame(0, 1);
+  EXPECT_GT(full->channels().size(), frame->channels().size());
+  EXPECT_LT(frame->bytes(), full->bytes());
+  EXPECT_TRUE(torch::equal(frame->depth, full->depth));
+  EXPECT_TRUE(torch::equal(frame->color, full->color));
+  // Colour only (a plain backbone) still brings the edge map: edge PSNR and the patch sampler's
+  // edge weighting read it.
+  EXPECT_EQ(open_for_channels(synthetic_dataset(), {}).frame(0, 1)->channels(),
+            std::vector<RenderChannel>{RenderChannel::Edge});
+}
+
 }  // namespace
 }  // namespace cgsr
