@@ -24,6 +24,7 @@ struct GlobalOptions {
   std::optional<int> threads;      // --threads N (0 = all hardware threads)
   std::optional<int64_t> seed;     // --seed N
   bool print_config = false;       // --print-config
+  bool check = false;              // --check
 };
 
 GlobalOptions& globals();
@@ -61,14 +62,17 @@ void begin_command(const RunSettings& run);
 // The run directory exists when --out is given, or always when `always_run_dir` is true
 // (default runs/<name>-<time>). `body` gets the options, the resolved config and the run
 // directory, and returns the results written to results.json. `place_run_dir`, when given, moves
-// the run directory (e.g. a distributed rank's own subdirectory).
+// the run directory (e.g. a distributed rank's own subdirectory). `check`, when given, is what
+// --check does beyond parsing the options (e.g. cgsr run parses every stage's section), and
+// returns what it found to print.
 template <class T>
 CLI::App* add_command(CLI::App& app, const std::string& name, const std::string& description,
                       std::function<config::Schema<T>()> schema,
                       std::function<void(CLI::App&, std::vector<FlagAssignment>&)> flags,
                       std::function<nlohmann::ordered_json(const T&, const YAML::Node&, RunDir*)> body,
                       bool always_run_dir,
-                      std::function<std::filesystem::path(const T&, const std::filesystem::path&)> place_run_dir = {}) {
+                      std::function<std::filesystem::path(const T&, const std::filesystem::path&)> place_run_dir = {},
+                      std::function<std::string(const T&)> check = {}) {
   CLI::App* sub = app.add_subcommand(name, description);
   auto assignments = std::make_shared<std::vector<FlagAssignment>>();
   if (flags) flags(*sub, *assignments);
@@ -79,6 +83,11 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
     const YAML::Node resolved = the_schema.emit(options);
     if (globals().print_config) {
       std::fputs(config::to_yaml(resolved).c_str(), stdout);
+      return;
+    }
+    if (globals().check) {  // nothing runs, nothing is written
+      if (check) std::fputs(check(options).c_str(), stdout);
+      std::printf("cgsr %s: the config is valid\n", name.c_str());
       return;
     }
     begin_command(options);

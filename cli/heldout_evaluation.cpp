@@ -19,14 +19,18 @@ config::Schema<HeldoutOptions> heldout_schema() {
   return s;
 }
 
+RenderOptions heldout_scene(const std::string& config) {
+  RenderOptions scene = config::parse_document(config::Document::load_file(config), render_schema());
+  if (!scene.scenes.empty()) throw Error(config, "is a scene set; list its scene configs under heldout.scenes one by one");
+  return scene;
+}
+
 nlohmann::ordered_json run_heldout(const HeldoutOptions& options, const HeldoutJob& job, const fs::path& dir) {
   nlohmann::ordered_json summary;
   summary["scenes"] = nlohmann::ordered_json::array();
   std::set<std::string> names;
   for (size_t i = 0; i < options.scenes.size(); ++i) {
-    RenderOptions scene = config::parse_document(config::Document::load_file(options.scenes[i]), render_schema());
-    if (!scene.scenes.empty())
-      throw Error(options.scenes[i], "is a scene set; list its scene configs under heldout.scenes one by one");
+    RenderOptions scene = heldout_scene(options.scenes[i]);
     scene.seed = job.seed;
     scene.threads = job.threads;
     scene.frames = options.frames;

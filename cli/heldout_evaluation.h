@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/commands/render.h"
 #include "core/config.h"
 #include "render_data/dataset.h"
 #include "train/evaluation.h"
@@ -33,6 +34,9 @@ struct HeldoutJob {
   EvalOptions eval;                 // metric options of the run (split, frames and latency are replaced)
   int seed = 0, threads = 0;
 };
+
+// A held-out scene's render config (one scene: a scene set is an error naming the file).
+RenderOptions heldout_scene(const std::string& config);
 
 // Renders each scene into dir/<n>_<scene>/data (resuming an interrupted render) and evaluates the
 // job's models on all its frames into dir/<n>_<scene>/eval. Returns {"scenes": [{scene, data,

@@ -76,8 +76,6 @@ void setup_render(CLI::App& app) {
       /*always_run_dir=*/true);
 }
 
-namespace {
-// The scene set's entries as render jobs, each parsed from its config file.
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options) {
   std::vector<SceneRenderJob> jobs;
   for (const auto& entry : options.scenes) {
@@ -98,6 +96,7 @@ std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options) {
   return jobs;
 }
 
+namespace {
 nlohmann::ordered_json sizes_json(const RenderJobResult& r) {
   nlohmann::ordered_json sizes;
   const auto& kinds = all_file_kinds();

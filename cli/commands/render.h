@@ -34,6 +34,8 @@ struct RenderOptions : RunSettings, RenderJobOptions {
 };
 
 config::Schema<RenderOptions> render_schema();
+// The scene set's entries as render jobs, each parsed from its config file with its overrides.
+std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options);
 void setup_render(CLI::App& app);
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out);
 

@@ -87,7 +87,7 @@ void setup_run(CLI::App& app) {
         }
         return run_pipeline(options, resolved, dir);
       },
-      /*always_run_dir=*/false);
+      /*always_run_dir=*/false, /*place_run_dir=*/{}, check_pipeline);
 }
 
 namespace {
@@ -262,6 +262,51 @@ class Pipeline {
       throw Error(root_.string(), "the verdict failed " + std::to_string(verdict.failed()) + " check(s) (see verdict.txt)",
                   ErrorKind::Internal);
     return results_;
+  }
+
+  // What --check prints: the constructor parsed every stage's section; this parses every scene
+  // config the run names too (the held-out ones are read only when that stage starts, hours in)
+  // and says what each stage will do.
+  std::string plan() const {
+    std::string out;
+    const auto line = [&](const std::string& stage, const std::string& what) {
+      out += fmt::format("  {:<8} {}\n", stage, what);
+    };
+    const auto schedule = [](const TrainSchedule& s) {
+      return fmt::format("{} steps of batch {} at {}x{} LR patches", s.steps, s.batch_size, s.patch_size, s.patch_size);
+    };
+    if (rendering_) {
+      std::vector<RenderJobOptions> scenes = {scene_};
+      if (!scene_.scenes.empty()) {
+        scenes.clear();
+        for (const auto& job : scene_set_jobs(scene_)) scenes.push_back(job.options);
+      }
+      int frames = 0;
+      for (const auto& s : scenes) frames += s.frames;
+      line("render", fmt::format("{}: {} scene(s), {} frames at {}", options_.scene, scenes.size(), frames,
+                                 join(scenes.front().resolutions)));
+    } else {
+      line("data", options_.data);
+    }
+    line("train", fmt::format("{} x{}, {}", backbone_.model, backbone_.scale, schedule(backbone_.schedule)));
+    line("enhance", fmt::format("RIT from {}, {}", enum_name(enhanced_.enhance.rit.source), schedule(enhanced_.schedule)));
+    line("control", "the same without the RIT");
+    line("search", fmt::format("{}, population {} over {} generations, candidates {}; the pick {}",
+                               search_.search.strategy.type, search_.search.population, search_.search.generations,
+                               schedule(search_.candidate.schedule), schedule(search_.final_schedule)));
+    line("prune", fmt::format("{} patterns, fine-tuning {}", prune_.pool.keep_rates.size(),
+                              prune_.finetune.epochs > 0 ? fmt::format("{} epochs", prune_.finetune.epochs)
+                                                         : schedule(prune_.finetune.schedule)));
+    std::vector<std::string> formats;
+    for (auto f : options_.export_formats) formats.push_back(enum_name(f));
+    line("export", join(formats));
+    line("eval", "the " + eval_.split + " split" + (eval_.frames.empty() ? "" : ", frames " + eval_.frames));
+    for (const auto& config : options_.heldout.scenes) heldout_scene(config);
+    if (!options_.heldout.scenes.empty())
+      line("heldout", fmt::format("{} scene(s), {} frames each: {}", options_.heldout.scenes.size(),
+                                  options_.heldout.frames, join(options_.heldout.scenes)));
+    line("report", (stages_.dir("report") / "report.md").string());
+    return out;
   }
 
  private:
@@ -590,6 +635,11 @@ class Pipeline {
 
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved, const fs::path& root) {
   return Pipeline(options, resolved, root).run();
+}
+
+std::string check_pipeline(const PipelineOptions& options) {
+  const fs::path root = globals().out.empty() ? fs::path("runs") / options.name : fs::path(globals().out);
+  return root.string() + ":\n" + Pipeline(options, YAML::Node(), root).plan();
 }
 
 }  // namespace cgsr::cli

@@ -53,5 +53,9 @@ const std::vector<std::string>& pipeline_stages();
 void setup_run(CLI::App& app);
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved,
                                     const std::filesystem::path& dir);
+// `cgsr run --check`: parses every stage's section and every scene config the run names (a
+// mistake is a cgsr::Error at its file, line and key) and returns what each stage will do;
+// runs and writes nothing.
+std::string check_pipeline(const PipelineOptions& options);
 
 }  // namespace cgsr::cli

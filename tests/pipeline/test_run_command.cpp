@@ -211,3 +211,55 @@ TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   EXPECT_NE(stage.err.find("from: must be one of: render, train"), std::string::npos) << stage.err;
   fs::remove_all(dir);
 }
+
+TEST(RunCommand, CheckReadsEverySceneConfigAndWritesNothing) {
+  const auto dir = scratch_dir("run-command-check");
+  const auto config_file = write_config(dir);
+  const std::string base = "run --check --config " + config_file.string() + " --out " + (dir / "run").string();
+  const CliResult ok = run_cgsr(base);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("train    pan x2, 6 steps of batch 2 at 16x16 LR patches"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("heldout  1 scene(s), 2 frames each"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("cgsr run: the config is valid"), std::string::npos) << ok.out;
+  EXPECT_FALSE(fs::exists(dir / "run"));
+
+  // The held-out scenes are read when their stage starts, after every network has trained: a
+  // mistake there is found by --check, with its file and key.
+  std::ofstream(dir / "bad_heldout.yaml") << std::string(kHeldoutScene) + "framez: 3\n";
+  const CliResult typo = run_cgsr(base + " --set heldout.scenes=[" + (dir / "bad_heldout.yaml").string() + "]");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.err.find("bad_heldout.yaml"), std::string::npos) << typo.err;
+  EXPECT_NE(typo.err.find("unknown key 'framez'"), std::string::npos) << typo.err;
+  std::ofstream(dir / "set.yaml") << "name: a-set\nscenes:\n  - {config: " + (dir / "heldout.yaml").string() + "}\n";
+  const CliResult scene_set = run_cgsr(base + " --set heldout.scenes=[" + (dir / "set.yaml").string() + "]");
+  EXPECT_EQ(scene_set.exit_code, 2);
+  EXPECT_NE(scene_set.err.find("is a scene set"), std::string::npos) << scene_set.err;
+  EXPECT_FALSE(fs::exists(dir / "run"));
+  fs::remove_all(dir);
+}
+
+// Every pipeline config the project ships (configs/*.yaml; the folders hold other commands'
+// configs), stage sections and scene configs included, parses: configs/general.yaml runs for
+// hours, and a mistake in its last stage would cost them all.
+TEST(RunCommand, EveryShippedPipelineConfigChecks) {
+  const fs::path source = CGSR_SOURCE_DIR;
+  std::vector<std::string> runs;
+  for (const auto& entry : fs::directory_iterator(source / "configs"))
+    if (entry.path().extension() == ".yaml") runs.push_back("--config " + entry.path().string());
+  ASSERT_GE(runs.size(), 3u);
+  // The OpenArena command of configs/general.yaml's header.
+  runs.push_back("--config configs/general.yaml --set scene=configs/scenes/general_oa_set.yaml --set "
+                 "'heldout.scenes=[configs/scenes/corridors.yaml, configs/scenes/heldout_hall.yaml, "
+                 "configs/scenes/heldout_outdoor.yaml, configs/scenes/heldout_room.yaml, configs/scenes/oa_dm1.yaml, "
+                 "configs/scenes/oa_dm4.yaml, configs/scenes/oa_dm5.yaml]'");
+  // The configs name their scenes relative to the project root, where the README runs them.
+  const fs::path here = fs::current_path();
+  fs::current_path(source);
+  for (const auto& run : runs) {
+    const CliResult r = run_cgsr("run --check " + run);
+    EXPECT_EQ(r.exit_code, 0) << run << "\n" << r.err;
+    EXPECT_NE(r.out.find("cgsr run: the config is valid"), std::string::npos) << run << "\n" << r.out;
+  }
+  EXPECT_NE(run_cgsr("run --check " + runs.back()).out.find("heldout  7 scene(s)"), std::string::npos);
+  fs::current_path(here);
+}
