@@ -69,6 +69,13 @@ config::Schema<PipelineOptions> pipeline_schema() {
   return s;
 }
 
+namespace {
+// The default directory is stable (runs/<name>), so that a rerun finds its finished stages.
+fs::path run_root(const PipelineOptions& options) {
+  return globals().out.empty() ? fs::path("runs") / options.name : fs::path(globals().out);
+}
+}  // namespace
+
 void setup_run(CLI::App& app) {
   add_command<PipelineOptions>(
       app, "run", "The whole pipeline: render, train, CG-enhance, search, prune, export, evaluate, report",
@@ -78,8 +85,7 @@ void setup_run(CLI::App& app) {
         flag_to_key(sub, flags, "--data", "data", "use this data set instead of rendering the scene");
       },
       [](const PipelineOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
-        // The default directory is stable (runs/<name>), so that a rerun finds its finished stages.
-        const fs::path dir = run_dir ? run_dir->path() : fs::path("runs") / options.name;
+        const fs::path dir = run_root(options);
         std::unique_ptr<RunDir> own;
         if (!run_dir) {
           own = std::make_unique<RunDir>(dir);
@@ -638,8 +644,7 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
 }
 
 std::string check_pipeline(const PipelineOptions& options) {
-  const fs::path root = globals().out.empty() ? fs::path("runs") / options.name : fs::path(globals().out);
-  return root.string() + ":\n" + Pipeline(options, YAML::Node(), root).plan();
+  return run_root(options).string() + ":\n" + Pipeline(options, YAML::Node(), run_root(options)).plan();
 }
 
 }  // namespace cgsr::cli
