@@ -114,8 +114,8 @@ std::string entity_text() {
 }
 
 std::vector<uint8_t> uniform_rgb(int width, int height, std::array<uint8_t, 3> c) {
-  std::vector<uint8_t> out;
-  for (int i = 0; i < width * height; ++i) out.insert(out.end(), c.begin(), c.end());
+  std::vector<uint8_t> out(static_cast<size_t>(width) * height * 3);
+  for (size_t i = 0; i < out.size(); ++i) out[i] = c[i % 3];
   return out;
 }
 
