@@ -1,5 +1,7 @@
 #include "render_data/dataset.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <list>
 #include <mutex>
@@ -34,6 +36,12 @@ config::Schema<DatasetOpenOptions> dataset_open_schema() {
   s.field("cache_gb", &DatasetOpenOptions::cache_gb, "frame cache budget, GiB").range(0, 1024);
   s.section("edges", &DatasetOpenOptions::edges, edge_settings_schema(), "thresholds for derived edges");
   return s;
+}
+
+double default_frame_cache_gb() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return 3.0;  // unknown: what fits on a small machine
+  return 0.5 * static_cast<double>(pages) * static_cast<double>(page) / (1ull << 30);
 }
 
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {

@@ -28,6 +28,12 @@
 
 namespace cgsr {
 
+// Half the machine's physical memory, in GiB: the frame cache's default budget. A cache that
+// overflows decodes the same frames again and again (training on configs/general.yaml's
+// OpenArena set reads 1300 frames with HR G-buffers, 8 GB), and the processes that read a data
+// set need little else; the cache changes no result, only how often a frame is decoded.
+double default_frame_cache_gb();
+
 struct DatasetOpenOptions {
   std::string layout = "auto";           // auto, or a registered layout name
   std::vector<std::string> channels;     // channels to load; empty: every stored + derived channel
@@ -35,7 +41,7 @@ struct DatasetOpenOptions {
   bool clean_grid_lines = false;         // cgsr-release: remove the simulator's tile-grid lines
   double near_plane = 0, far_plane = 0;  // layouts without planes (cgsr-release, glob): 0 = layout default
   double vfov = 0;                       // vertical FOV for derived normals; 0 = layout default
-  double cache_gb = 3.0;                 // frame cache budget, GiB
+  double cache_gb = default_frame_cache_gb();  // frame cache budget, GiB
   EdgeSettings edges;                    // thresholds for derived edges
 };
 

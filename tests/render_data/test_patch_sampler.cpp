@@ -4,6 +4,7 @@
 
 #include <torch/torch.h>
 
+#include <fstream>
 #include <set>
 
 #include "core/error.h"
@@ -200,6 +201,13 @@ TEST(Dataset, CacheStaysWithinItsBudget) {
   EXPECT_GT(data.cached_bytes(), 0u);
   // A frame dropped from the cache loads again, identically.
   EXPECT_TRUE(torch::equal(data.frame(0, 1)->color, data.load(0, 1).color));
+  // By default the cache may take half the machine's memory (/proc/meminfo says how much it has).
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double total_kib = 0;
+  meminfo >> key >> total_kib;
+  ASSERT_EQ(key, "MemTotal:");
+  EXPECT_NEAR(DatasetOpenOptions().cache_gb, 0.5 * total_kib / (1 << 20), 0.01 * total_kib / (1 << 20));
 }
 
 TEST(Dataset, OpenForChannelsLoadsWhatIsNamedAndTheEdgeMap) {
