@@ -1,8 +1,11 @@
 #include "render_data/dataset.h"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <fstream>
+#include <limits>
 #include <list>
 #include <mutex>
 #include <unordered_map>
@@ -34,14 +37,44 @@ config::Schema<DatasetOpenOptions> dataset_open_schema() {
   s.field("far", &DatasetOpenOptions::far_plane, "far plane for layouts without one (0: default)").at_least(0);
   s.field("vfov", &DatasetOpenOptions::vfov, "vertical field of view for derived normals (0: default)").range(0, 179);
   s.field("cache_gb", &DatasetOpenOptions::cache_gb, "frame cache budget, GiB").range(0, 1024);
+  s.field("cache_reserve_gb", &DatasetOpenOptions::cache_reserve_gb,
+          "machine memory the frame cache leaves available, GiB")
+      .range(0, 1024);
   s.section("edges", &DatasetOpenOptions::edges, edge_settings_schema(), "thresholds for derived edges");
   return s;
 }
 
-double default_frame_cache_gb() {
+namespace {
+
+constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
+
+double physical_memory_gb() {
   const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page <= 0) return 3.0;  // unknown: what fits on a small machine
-  return 0.5 * static_cast<double>(pages) * static_cast<double>(page) / (1ull << 30);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) / kGiB : 0;
+}
+
+// MemAvailable of /proc/meminfo in bytes; the largest size_t when the machine does not say.
+size_t available_memory_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  size_t kib = 0;
+  while (meminfo >> key >> kib) {
+    if (key == "MemAvailable:") return kib * 1024;
+    meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  return std::numeric_limits<size_t>::max();
+}
+
+}  // namespace
+
+double default_frame_cache_gb() {
+  const double gb = physical_memory_gb();
+  return gb > 0 ? 0.5 * gb : 3.0;  // unknown: what fits on a small machine
+}
+
+double default_frame_cache_reserve_gb() {
+  const double gb = physical_memory_gb();
+  return gb > 0 ? gb / 8 : 1.0;
 }
 
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
@@ -172,6 +205,16 @@ struct Dataset::Impl {
   };
   mutable std::unordered_map<Key, Entry> cache;
   mutable size_t bytes = 0;
+  size_t reserve = 0;  // machine memory the cache leaves available
+
+  // glibc keeps freed frames in its heap for reuse: without the trim a run's next stage (another
+  // data set, other channels) would add its cache to this one's in the process's memory.
+  ~Impl() {
+    if (bytes == 0) return;
+    cache.clear();
+    lru.clear();
+    ::malloc_trim(0);
+  }
 
   Frame load(int index, size_t res) const {
     if (index < 0 || index >= info.frames)
@@ -228,7 +271,8 @@ Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
       std::find(impl.load_channels.begin(), impl.load_channels.end(), RenderChannel::Depth) == impl.load_channels.end())
     impl.load_channels.push_back(RenderChannel::Depth);
   std::sort(impl.load_channels.begin(), impl.load_channels.end());
-  impl.budget = static_cast<size_t>(options.cache_gb * 1024.0 * 1024.0 * 1024.0);
+  impl.budget = static_cast<size_t>(options.cache_gb * kGiB);
+  impl.reserve = static_cast<size_t>(options.cache_reserve_gb * kGiB);
   return d;
 }
 
@@ -323,6 +367,8 @@ std::shared_ptr<const Frame> Dataset::frame(int index, size_t resolution) const 
   if (it != impl.cache.end()) return it->second.frame;
   const size_t size = frame->bytes();
   if (size > impl.budget) return frame;  // larger than the whole cache: not kept
+  // Growing (not replacing frames) only while the machine keeps its reserve.
+  if (impl.bytes + size <= impl.budget && available_memory_bytes() < impl.reserve + size) return frame;
   while (impl.bytes + size > impl.budget && !impl.lru.empty()) {
     const Impl::Key victim = impl.lru.back();
     impl.lru.pop_back();

@@ -12,7 +12,8 @@
 //   glob          any capture described by a YAML file of per-channel glob patterns (glob_layout.h)
 // Every loader produces the same in-memory Frame (frame.h). Channels the data lacks are derived
 // on request (derive_channels.h) and listed in info().derived. Frames are cached up to a byte
-// budget (least recently used frames are dropped); the cache is thread-safe.
+// budget (least recently used frames are dropped) while the machine keeps a reserve of memory
+// available; the cache is thread-safe.
 
 #include <filesystem>
 #include <functional>
@@ -34,6 +35,11 @@ namespace cgsr {
 // set need little else; the cache changes no result, only how often a frame is decoded.
 double default_frame_cache_gb();
 
+// An eighth of the machine's physical memory, in GiB: what a frame cache leaves available. A
+// cache stops growing when the machine has less than this available, so that processes reading
+// data sets side by side (a run beside an evaluation) cannot take more than the machine has.
+double default_frame_cache_reserve_gb();
+
 struct DatasetOpenOptions {
   std::string layout = "auto";           // auto, or a registered layout name
   std::vector<std::string> channels;     // channels to load; empty: every stored + derived channel
@@ -42,6 +48,7 @@ struct DatasetOpenOptions {
   double near_plane = 0, far_plane = 0;  // layouts without planes (cgsr-release, glob): 0 = layout default
   double vfov = 0;                       // vertical FOV for derived normals; 0 = layout default
   double cache_gb = default_frame_cache_gb();  // frame cache budget, GiB
+  double cache_reserve_gb = default_frame_cache_reserve_gb();  // memory the cache leaves available, GiB
   EdgeSettings edges;                    // thresholds for derived edges
 };
 

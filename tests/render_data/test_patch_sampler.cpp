@@ -208,6 +208,20 @@ TEST(Dataset, CacheStaysWithinItsBudget) {
   meminfo >> key >> total_kib;
   ASSERT_EQ(key, "MemTotal:");
   EXPECT_NEAR(DatasetOpenOptions().cache_gb, 0.5 * total_kib / (1 << 20), 0.01 * total_kib / (1 << 20));
+  EXPECT_NEAR(DatasetOpenOptions().cache_reserve_gb, total_kib / 8 / (1 << 20), 0.01 * total_kib / (1 << 20));
+}
+
+TEST(Dataset, CacheStopsGrowingWhenTheMachineIsShortOfMemory) {
+  // A reserve larger than any machine's memory: the cache never grows, and frames still load.
+  DatasetOpenOptions o;
+  o.cache_reserve_gb = 1000;
+  const Dataset short_of_memory = Dataset::open(synthetic_dataset(), o);
+  for (int f = 0; f < 3; ++f) EXPECT_TRUE(torch::equal(short_of_memory.frame(f, 1)->color, short_of_memory.load(f, 1).color));
+  EXPECT_EQ(short_of_memory.cached_bytes(), 0u);
+  o.cache_reserve_gb = 0;
+  const Dataset plenty = Dataset::open(synthetic_dataset(), o);
+  plenty.frame(0, 1);
+  EXPECT_EQ(plenty.cached_bytes(), plenty.frame(0, 1)->bytes());
 }
 
 TEST(Dataset, OpenForChannelsLoadsWhatIsNamedAndTheEdgeMap) {
