@@ -10,7 +10,7 @@
 //                 (same weights, same parameters, any runtime runs it)
 //   hr_fuse       info at HR feeds a branch at the backbone's HR features (after its last
 //                 upsampling, before its last HR convolutions): what the colour cannot tell is
-//                 where geometry edges are at the output resolution (seed 004)
+//                 where geometry edges are at the output resolution
 //   hr_unshuffle+hr_fuse  both, from the one HR input (multi-scale)
 //
 // Each part is gate -> conv -> LeakyReLU 0.2 -> fusion:
