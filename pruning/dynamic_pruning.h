@@ -8,7 +8,7 @@
 //      the weights the pattern leaves out; pattern_masks.h). lambda_pruned is 0 by default: with
 //      nested patterns every weight a narrow pattern leaves out is one a wider pattern uses, and
 //      the L1 term (a sum over those weights) shrank them until the static network lost 0.24 dB
-//      on the quickstart at 1e-4 (README, "Dynamic pruning"). The widest pattern, the static
+//      on the quickstart at 1e-4 (docs/results/dynamic_pruning.md). The widest pattern, the static
 //      network, is itself trained. With `distill` the narrower patterns learn the widest's
 //      output (detached) instead of the HR frame (in-place distillation, as slimmable networks
 //      are trained): their gradients then pull the shared channels toward what the widest

@@ -1,5 +1,5 @@
 #pragma once
-// Evaluation of any upscaler on full frames of a data set split: per-frame PSNR/SSIM (README
+// Evaluation of any upscaler on full frames of a data set split: per-frame PSNR/SSIM (docs/design.md
 // convention), PSNR on geometry edges and on the rest of the frame (the HR edge channel grown by
 // one pixel, edges.h; needs the dataset to carry edges at HR, whatever the upscaler reads),
 // temporal stability (warping error between consecutive outputs using the rendered motion
