@@ -13,7 +13,7 @@
 #include "core/config.h"
 #include "models/inherit.h"
 #include "models/sr_network.h"
-#include "pruning/channel_selection.h"
+#include "models/channel_selection.h"
 #include "pruning/prunable_units.h"
 
 namespace cgsr {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "pruning/channel_selection.h"
+#include "models/channel_selection.h"
 #include "tests/pruning/pruning_cases.h"
 
 using namespace cgsr;

@@ -1,6 +1,8 @@
-#include "pruning/channel_selection.h"
+#include "models/channel_selection.h"
 
 #include <torch/torch.h>
+
+#include <optional>
 
 #include "core/error.h"
 
@@ -14,7 +16,7 @@ const std::vector<int64_t>* find_kept(const ChannelSelection& keep, const graph:
 }
 
 // A leading run of positions 0, 1, ..., n - 1 (nested patterns) is a view; anything else a copy.
-torch::Tensor take(const torch::Tensor& t, int64_t dim, const std::vector<int64_t>& index) {
+torch::Tensor slice_or_gather(const torch::Tensor& t, int64_t dim, const std::vector<int64_t>& index) {
   bool prefix = true;
   for (size_t i = 0; i < index.size() && prefix; ++i) prefix = index[i] == static_cast<int64_t>(i);
   if (prefix) return t.narrow(dim, 0, static_cast<int64_t>(index.size()));
@@ -88,21 +90,22 @@ SelectedTensors select_op_tensors(const graph::Graph& graph, const graph::Op& op
     CGSR_CHECK(op.groups == 1, "select_channels: grouped convolution " + op.name + " cannot be narrowed");
     if (out_narrows) {
       const auto rows = selected_positions(out_layout, keep);
-      t.weight = take(t.weight, 0, rows);
-      if (t.bias.defined()) t.bias = take(t.bias, 0, rows);
+      t.weight = slice_or_gather(t.weight, 0, rows);
+      if (t.bias.defined()) t.bias = slice_or_gather(t.bias, 0, rows);
     }
-    if (in_narrows) t.weight = take(t.weight, 1, selected_positions(in_layout, keep));
+    if (in_narrows) t.weight = slice_or_gather(t.weight, 1, selected_positions(in_layout, keep));
   } else if (graph::op_traits(op.kind).has_tensors && out_narrows) {
     const auto positions = selected_positions(out_layout, keep);
-    if (t.scale.defined()) t.scale = take(t.scale, 0, positions);
-    if (t.shift.defined()) t.shift = take(t.shift, 0, positions);
+    if (t.scale.defined()) t.scale = slice_or_gather(t.scale, 0, positions);
+    if (t.shift.defined()) t.shift = slice_or_gather(t.shift, 0, positions);
   }
   return t;
 }
 
-graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep) {
+graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep, bool differentiable) {
   check_selection(graph, keep, "channel selection");
-  torch::NoGradGuard no_grad;
+  std::optional<torch::NoGradGuard> no_grad;
+  if (!differentiable) no_grad.emplace();
   graph::Graph out = graph;
   for (auto& op : out.ops) {
     if (!graph::op_traits(op.kind).has_tensors) continue;

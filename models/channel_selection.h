@@ -34,8 +34,10 @@ void check_selection(const graph::Graph& graph, const ChannelSelection& keep, co
 
 // The graph restricted to the selection: Conv and ChannelAffine tensors are gathered copies, or
 // views where the kept positions are a leading run (the first channels of a group), every value's
-// layout narrowed. Ops and values keep their indices and names.
-graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep);
+// layout narrowed. Ops and values keep their indices and names. With `differentiable` the
+// narrowing is recorded by autograd (under the caller's grad mode), so a loss of the narrowed
+// graph reaches the original tensors: how subnets of an elastic network train (models/subnet.h).
+graph::Graph select_channels(const graph::Graph& graph, const ChannelSelection& keep, bool differentiable = false);
 
 // The gathered tensors of one op under a selection (what select_channels puts into the op).
 struct SelectedTensors {

@@ -1,0 +1,260 @@
+#include "models/latency_table.h"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "core/error.h"
+#include "core/progress.h"
+#include "core/timing.h"
+#include "models/fused_graph.h"
+#include "models/subnet.h"
+
+namespace cgsr {
+
+config::Schema<LatencyTableOptions> latency_table_schema() {
+  config::Schema<LatencyTableOptions> s;
+  s.field("runs", &LatencyTableOptions::runs, "timed runs per convolution shape (median)").range(1, 1000);
+  s.field("calibration_subnets", &LatencyTableOptions::calibration_subnets,
+          "random subnets measured whole to calibrate the sum").range(1, 1000);
+  s.field("check_subnets", &LatencyTableOptions::check_subnets,
+          "random subnets measured whole to report the prediction error").range(0, 1000);
+  s.field("subnet_runs", &LatencyTableOptions::subnet_runs, "timed runs per whole subnet (median)").range(1, 1000);
+  return s;
+}
+
+namespace {
+
+struct ConvShape {
+  int64_t kernel = 1, in = 0, out = 0, stride = 1, padding = 0, groups = 1, factor = 1;
+  std::string key() const {
+    return "k" + std::to_string(kernel) + "_i" + std::to_string(in) + "_o" + std::to_string(out) + "_s" +
+           std::to_string(stride) + "_p" + std::to_string(padding) + "_g" + std::to_string(groups) + "_f" +
+           std::to_string(factor);
+  }
+};
+
+ConvShape shape_of(const graph::Graph& graph, const graph::Op& op) {
+  return {op.kernel_size(),
+          graph::layout_width(graph.values[op.inputs[0]].layout),
+          graph::layout_width(graph.values[op.output].layout),
+          op.stride,
+          op.padding,
+          op.groups,
+          graph.values[op.output].factor};
+}
+
+// Widths a layout can take in the space's subnets: every combination of its groups' choices.
+std::vector<int64_t> widths_of(const graph::Layout& layout, const std::map<std::string, std::vector<int64_t>>& choices,
+                               const std::map<std::string, int64_t>& fixed) {
+  std::set<int64_t> sums = {0};
+  std::set<std::string> seen;
+  for (const auto& s : layout) {
+    std::vector<int64_t> options = {s.channels};
+    if (s.prunable) {
+      const auto it = choices.find(s.group);
+      if (it != choices.end()) options = it->second;
+      if (fixed.count(s.group)) options = {fixed.at(s.group)};
+    }
+    std::set<int64_t> next;
+    for (int64_t sum : sums)
+      for (int64_t w : options) next.insert(sum + w * s.repeat);
+    sums = std::move(next);
+  }
+  return {sums.begin(), sums.end()};
+}
+
+double time_conv(const ConvShape& c, int64_t w, int64_t h, int runs) {
+  if (c.groups != 1) throw Error("latency table", "grouped convolutions are not timed", ErrorKind::Internal);
+  graph::Builder g;
+  const int x = g.input("x", graph::fixed_layout("x", c.in), c.factor * c.stride);
+  const auto weight = torch::randn({c.out, c.in / c.groups, c.kernel, c.kernel}) * 0.1;
+  const auto bias = torch::zeros({c.out});
+  g.output("y", g.conv("conv", x, weight, bias, c.padding, graph::fixed_layout("y", c.out), true, c.stride));
+  FusedGraph fused(g.finish());
+  const auto input = torch::rand({1, c.in, h * c.factor * c.stride, w * c.factor * c.stride});
+  return measure_latency([&] { fused.run({{"x", input}}); }, /*warmup=*/2, runs).median_ms;
+}
+
+// Solves the least-squares fit of y = a x0 + b x1 + c; false when degenerate.
+bool fit_linear(const std::vector<std::array<double, 3>>& x, const std::vector<double>& y, std::array<double, 3>& out) {
+  double m[3][4] = {};
+  for (size_t i = 0; i < x.size(); ++i)
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[r][c] += x[i][r] * x[i][c];
+      m[r][3] += x[i][r] * y[i];
+    }
+  for (int col = 0; col < 3; ++col) {
+    int pivot = col;
+    for (int r = col + 1; r < 3; ++r)
+      if (std::abs(m[r][col]) > std::abs(m[pivot][col])) pivot = r;
+    if (std::abs(m[pivot][col]) < 1e-12) return false;
+    for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[pivot][c]);
+    for (int r = 0; r < 3; ++r) {
+      if (r == col) continue;
+      const double f = m[r][col] / m[col][col];
+      for (int c = 0; c < 4; ++c) m[r][c] -= f * m[col][c];
+    }
+  }
+  for (int r = 0; r < 3; ++r) out[r] = m[r][3] / m[r][r];
+  return std::all_of(out.begin(), out.end(), [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+std::string conv_shape_key(const graph::Graph& graph, const graph::Op& op) { return shape_of(graph, op).key(); }
+
+std::pair<double, double> LatencyTable::features(const graph::Graph& graph) const {
+  double conv = 0, elements = 0;
+  for (const auto& op : graph.ops) {
+    if (op.kind == graph::OpKind::Conv) {
+      const std::string key = conv_shape_key(graph, op);
+      const auto it = conv_ms.find(key);
+      if (it == conv_ms.end())
+        throw Error("latency table", "no time for " + op.name + " (" + key + "); the subnet is outside the table's space");
+      conv += it->second;
+    } else {
+      const auto& v = graph.values[op.output];
+      elements += static_cast<double>(graph::layout_width(v.layout)) * (lr_width * v.factor) * (lr_height * v.factor);
+    }
+  }
+  return {conv, elements};
+}
+
+double LatencyTable::predict(const graph::Graph& graph) const {
+  const auto [conv, elements] = features(graph);
+  return scale * conv + element_ns * 1e-6 * elements + offset_ms;
+}
+
+double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs) {
+  FusedGraph fused(graph);
+  std::vector<std::pair<std::string, torch::Tensor>> inputs;
+  for (const auto& [name, v] : graph.inputs) {
+    const auto& value = graph.values[v];
+    inputs.emplace_back(name, torch::rand({1, graph::layout_width(value.layout), lr_height * value.factor,
+                                           lr_width * value.factor}));
+  }
+  return measure_latency([&] { fused.run(inputs); }, /*warmup=*/2, runs).median_ms;
+}
+
+LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace& space, int64_t lr_width,
+                                   int64_t lr_height, const LatencyTableOptions& options) {
+  torch::NoGradGuard no_grad;
+  LatencyTable table;
+  table.lr_width = lr_width;
+  table.lr_height = lr_height;
+  table.threads = torch::get_num_threads();
+  const graph::Graph full = net.describe(false);
+  std::map<std::string, std::vector<int64_t>> choices;
+  for (const auto& gene : space.genes()) choices[gene.group] = gene.choices;
+  std::map<std::string, ConvShape> shapes;
+  for (const auto& op : full.ops) {
+    if (op.kind != graph::OpKind::Conv) continue;
+    ConvShape base = shape_of(full, op);
+    for (int64_t in : widths_of(full.values[op.inputs[0]].layout, choices, {}))
+      for (int64_t out : widths_of(full.values[op.output].layout, choices, {})) {
+        ConvShape c = base;
+        c.in = in;
+        c.out = out;
+        shapes.emplace(c.key(), c);
+      }
+  }
+  {
+    Progress progress("latency table", static_cast<int64_t>(shapes.size()));
+    for (const auto& [key, shape] : shapes) {
+      table.conv_ms[key] = time_conv(shape, lr_width, lr_height, options.runs);
+      progress.advance();
+    }
+  }
+  // Whole subnets: the full network, the smallest and random ones to fit; others to check.
+  std::mt19937_64 rng(options.seed);
+  std::vector<SubnetConfig> fit_set = {space.full(), space.smallest()};
+  for (int i = 0; i < options.calibration_subnets; ++i) fit_set.push_back(space.sample(rng));
+  std::vector<SubnetConfig> check_set;
+  for (int i = 0; i < options.check_subnets; ++i) check_set.push_back(space.sample(rng));
+  Progress progress("latency calibration", static_cast<int64_t>(fit_set.size() + check_set.size()));
+  std::vector<std::array<double, 3>> x;
+  std::vector<double> y;
+  for (const auto& sub : fit_set) {
+    const graph::Graph g = subnet_graph(net, sub);
+    const auto [conv, elements] = table.features(g);
+    x.push_back({conv, elements * 1e-6, 1.0});
+    y.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs));
+    progress.advance();
+  }
+  std::array<double, 3> coef{};
+  if (fit_linear(x, y, coef) && coef[0] > 0) {
+    table.scale = coef[0];
+    table.element_ns = coef[1];
+    table.offset_ms = coef[2];
+  } else {
+    // Too few distinct points: the sum as it is, shifted to the mean measured latency.
+    double residual = 0;
+    for (size_t i = 0; i < x.size(); ++i) residual += y[i] - x[i][0];
+    table.offset_ms = residual / static_cast<double>(x.size());
+  }
+  for (const auto& sub : check_set) {
+    const graph::Graph g = subnet_graph(net, sub);
+    table.error.predicted_ms.push_back(table.predict(g));
+    table.error.measured_ms.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs));
+    progress.advance();
+  }
+  table.error.subnets = static_cast<int>(check_set.size());
+  for (int i = 0; i < table.error.subnets; ++i) {
+    const double e = 100.0 * std::abs(table.error.predicted_ms[i] - table.error.measured_ms[i]) /
+                     table.error.measured_ms[i];
+    table.error.mean_abs_percent += e / table.error.subnets;
+    table.error.max_abs_percent = std::max(table.error.max_abs_percent, e);
+  }
+  return table;
+}
+
+nlohmann::ordered_json to_json(const LatencyTable& t) {
+  nlohmann::ordered_json conv = nlohmann::ordered_json::object();
+  for (const auto& [key, ms] : t.conv_ms) conv[key] = ms;
+  return {{"lr_size", {t.lr_width, t.lr_height}},
+          {"threads", t.threads},
+          {"calibration", {{"scale", t.scale}, {"element_ns", t.element_ns}, {"offset_ms", t.offset_ms}}},
+          {"error",
+           {{"subnets", t.error.subnets},
+            {"mean_abs_percent", t.error.mean_abs_percent},
+            {"max_abs_percent", t.error.max_abs_percent},
+            {"predicted_ms", t.error.predicted_ms},
+            {"measured_ms", t.error.measured_ms}}},
+          {"conv_ms", conv}};
+}
+
+LatencyTable latency_table_from_json(const nlohmann::ordered_json& j, const std::string& context) {
+  LatencyTable t;
+  try {
+    const auto size = j.at("lr_size").get<std::vector<int64_t>>();
+    if (size.size() != 2 || size[0] < 1 || size[1] < 1) throw Error(context + ": lr_size", "expected [width, height]");
+    t.lr_width = size[0];
+    t.lr_height = size[1];
+    t.threads = j.at("threads").get<int>();
+    const auto& c = j.at("calibration");
+    t.scale = c.at("scale").get<double>();
+    t.element_ns = c.at("element_ns").get<double>();
+    t.offset_ms = c.at("offset_ms").get<double>();
+    const auto& e = j.at("error");
+    t.error.subnets = e.at("subnets").get<int>();
+    t.error.mean_abs_percent = e.at("mean_abs_percent").get<double>();
+    t.error.max_abs_percent = e.at("max_abs_percent").get<double>();
+    t.error.predicted_ms = e.at("predicted_ms").get<std::vector<double>>();
+    t.error.measured_ms = e.at("measured_ms").get<std::vector<double>>();
+    for (const auto& [key, ms] : j.at("conv_ms").items()) {
+      const double v = ms.get<double>();
+      if (!std::isfinite(v) || v < 0) throw Error(context + ": conv_ms." + key, "not a time");
+      t.conv_ms[key] = v;
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(context, std::string("malformed latency table: ") + e.what());
+  }
+  return t;
+}
+
+}  // namespace cgsr

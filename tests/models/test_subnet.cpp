@@ -1,0 +1,219 @@
+// Subnets of a network (models/subnet.h) and the elastic space (models/elastic.h).
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <random>
+#include <set>
+
+#include "core/error.h"
+#include "models/elastic.h"
+#include "models/subnet.h"
+#include "tests/models/model_cases.h"
+
+namespace cgsr {
+namespace {
+
+// PAN x2 with 4 blocks and a RIT on both branches, small enough to run every case quickly.
+ArchSpec small_pan(int scale = 2) {
+  ArchSpec s = default_spec("pan", scale);
+  s.blocks = 4;
+  s.widths = {};
+  return test::with_rit(resolve_spec(s), "hr_unshuffle+hr_fuse");
+}
+
+ArchSpec small_edsr() {
+  ArchSpec s = default_spec("edsr", 2);
+  s.blocks = 3;
+  s.widths = {};
+  s = resolve_spec(s);
+  s.widths.set("features", 16);
+  s.widths.set("up1", 16);
+  for (int b = 0; b < 3; ++b) s.widths.set(block_group(b, "mid"), 16);
+  return resolve_spec(s);
+}
+
+torch::Tensor run_image(const graph::Graph& g, const torch::Tensor& color, const torch::Tensor& info,
+                        const graph::OpObserver& observer = {}) {
+  torch::NoGradGuard no_grad;
+  return graph::run(g, network_inputs(g, color, info), nullptr, observer).front().second;
+}
+
+// The full graph with the subnet's dropped channels zeroed after every op and the skipped blocks'
+// branches zeroed: what the subnet must compute.
+torch::Tensor masked_full(const SRNetworkImpl& net, const SubnetConfig& sub, const torch::Tensor& color,
+                          const torch::Tensor& info) {
+  const graph::Graph g = net.describe(false);
+  std::vector<int> block_of(g.ops.size(), -1);
+  std::map<int, size_t> last_op;  // block -> its last op (the residual sum)
+  for (size_t i = 0; i < g.ops.size(); ++i) {
+    const std::string prefix = "backbone.blocks.";
+    if (g.ops[i].name.rfind(prefix, 0) != 0) continue;
+    block_of[i] = std::stoi(g.ops[i].name.substr(prefix.size()));
+    last_op[block_of[i]] = i;
+  }
+  const auto observer = [&](size_t op, const torch::Tensor& out) -> torch::Tensor {
+    const int b = block_of[op];
+    const bool skipped = b >= 0 && !std::binary_search(sub.blocks.begin(), sub.blocks.end(), b);
+    if (skipped && last_op[b] != op) return torch::zeros_like(out);
+    auto masked = out.clone();
+    int64_t offset = 0;
+    for (const auto& s : g.values[g.ops[op].output].layout) {
+      if (s.prunable) {
+        const int64_t kept = subnet_width(sub, s.group, s.channels);
+        masked.narrow(1, offset + kept * s.repeat, (s.channels - kept) * s.repeat).zero_();
+      }
+      offset += s.channels * s.repeat;
+    }
+    return masked;
+  };
+  return run_image(g, color, info, observer);
+}
+
+TEST(Subnet, EqualsTheFullNetworkWithDroppedChannelsAndBlocksMasked) {
+  for (const ArchSpec& spec : {small_pan(2), small_pan(4), small_edsr()}) {
+    SCOPED_TRACE(spec_summary(spec));
+    const SRNetwork net = test::build_network(spec, 3);
+    const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+    std::mt19937_64 rng(7);
+    const auto [color, info] = test::random_inputs(spec, 9, 7);
+    for (int i = 0; i < 6; ++i) {
+      const SubnetConfig sub = i == 0 ? space.full() : i == 1 ? space.smallest() : space.sample(rng);
+      SCOPED_TRACE(subnet_key(sub));
+      const auto narrow = run_image(subnet_graph(*net, sub), color, info);
+      const auto masked = masked_full(*net, sub, color, info);
+      EXPECT_LT((narrow - masked).abs().max().item<double>(), 1e-5);
+    }
+  }
+}
+
+TEST(Subnet, SkippingABlockIsNotTheFullNetwork) {
+  const ArchSpec spec = small_pan();
+  const SRNetwork net = test::build_network(spec, 1);
+  SubnetConfig sub = full_subnet(spec);
+  const auto [color, info] = test::random_inputs(spec, 8, 8);
+  const auto full = run_image(subnet_graph(*net, sub), color, info);
+  EXPECT_TRUE(torch::equal(full, run_image(net->describe(false), color, info)));
+  sub.blocks = {0, 1, 3};
+  EXPECT_GT((run_image(subnet_graph(*net, sub), color, info) - full).abs().max().item<double>(), 1e-6);
+}
+
+TEST(Subnet, LeadingChannelsAreViewsOfTheNetworksWeights) {
+  const ArchSpec spec = small_pan();
+  const SRNetwork net = test::build_network(spec, 2);
+  SubnetConfig sub = full_subnet(spec);
+  sub.widths["block1_a"] = 8;
+  sub.widths["up1"] = 12;
+  sub.widths["rit"] = 8;
+  const graph::Graph g = subnet_graph(*net, sub);
+  std::set<const void*> storages;
+  for (const auto& p : net->parameters()) storages.insert(p.storage().data());
+  int views = 0, copies = 0;
+  for (const auto& op : g.ops) {
+    if (op.kind != graph::OpKind::Conv || !op.trainable) continue;
+    if (storages.count(op.weight.storage().data())) ++views; else ++copies;
+  }
+  // Every conv is a view but those reading a concatenation of narrowed groups (block 1's conv3).
+  EXPECT_EQ(copies, 1);
+  EXPECT_GT(views, 20);
+  const auto* k1 = g.find_op("backbone.blocks.1.k1");
+  ASSERT_NE(k1, nullptr);
+  EXPECT_EQ(k1->weight.size(0), 20);
+  EXPECT_EQ(k1->weight.size(1), 8);
+}
+
+TEST(Subnet, MaterializedSubnetComputesTheSameAsItsGraph) {
+  const ArchSpec spec = small_pan();
+  const SRNetwork net = test::build_network(spec, 4);
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  std::mt19937_64 rng(11);
+  const auto [color, info] = test::random_inputs(spec, 10, 6);
+  for (int i = 0; i < 4; ++i) {
+    const SubnetConfig sub = space.sample(rng);
+    SRNetwork small = materialize_subnet(*net, sub);
+    EXPECT_EQ(small->spec().blocks, static_cast<int>(sub.blocks.size()));
+    small->eval();
+    torch::NoGradGuard no_grad;
+    const auto a = small->forward(color, info);
+    const auto b = run_image(subnet_graph(*net, sub), color, info);
+    EXPECT_LT((a - b).abs().max().item<double>(), 1e-5) << subnet_key(sub);
+  }
+}
+
+TEST(Subnet, DifferentiableGraphTrainsTheKeptWeightsOnly) {
+  const ArchSpec spec = small_pan();
+  SRNetwork net = test::build_network(spec, 5);
+  SubnetConfig sub = full_subnet(spec);
+  sub.blocks = {0, 2, 3};
+  sub.widths["block0_a"] = 4;
+  const graph::Graph g = subnet_graph(*net, sub, false, /*differentiable=*/true);
+  const auto [color, info] = test::random_inputs(spec, 6, 6);
+  graph::run(g, network_inputs(g, color, info)).front().second.square().mean().backward();
+  const auto params = net->named_parameters();
+  const auto& k1 = params["backbone.blocks.0.k1.weight"].grad();  // [a_out, a, 3, 3]
+  ASSERT_TRUE(k1.defined());
+  EXPECT_GT(k1.narrow(1, 0, 4).abs().sum().item<double>(), 0);
+  EXPECT_EQ(k1.narrow(1, 4, 16).abs().sum().item<double>(), 0);
+  const auto& skipped = params["backbone.blocks.1.k1.weight"].grad();
+  EXPECT_TRUE(!skipped.defined() || skipped.abs().sum().item<double>() == 0);
+}
+
+TEST(Subnet, ProblemsAndJsonRoundTrip) {
+  const ArchSpec spec = small_pan();
+  SubnetConfig sub = full_subnet(spec);
+  EXPECT_TRUE(subnet_problems(spec, sub).empty());
+  EXPECT_EQ(subnet_from_json(to_json(sub), "test"), sub);
+  sub.blocks = {2, 1};
+  sub.widths["nope"] = 3;
+  sub.widths["features"] = 41;
+  EXPECT_EQ(subnet_problems(spec, sub).size(), 3u);
+  EXPECT_THROW(subnet_graph(*test::build_network(spec, 0), sub), Error);
+  EXPECT_THROW(subnet_from_json(nlohmann::ordered_json{{"blocks", "x"}}, "test"), Error);
+}
+
+TEST(ElasticSpace, ChoicesSamplesAndRepair) {
+  const ArchSpec spec = small_pan();
+  const ElasticSpace space(spec, ElasticOptions{4, 0.5, 2}, {3, 1, 0, 2});
+  for (const auto& gene : space.genes()) {
+    EXPECT_EQ(gene.choices.back(), gene.full) << gene.group;
+    EXPECT_GE(gene.choices.front() * 2, gene.full) << gene.group;
+    for (size_t i = 0; i + 1 < gene.choices.size(); ++i) EXPECT_EQ(gene.choices[i] % 4, 0) << gene.group;
+  }
+  EXPECT_EQ(space.smallest().blocks, (std::vector<int>{1, 3}));  // the two most important
+  EXPECT_TRUE(space.contains(space.full()));
+  EXPECT_TRUE(space.contains(space.smallest()));
+  // Limits at 0 give the full network; a limit opens the range progressively.
+  EXPECT_EQ(space.smallest(ShrinkLimits{0, 0}), space.full());
+  std::mt19937_64 rng(1);
+  for (int i = 0; i < 50; ++i) {
+    const auto sub = space.sample(rng);
+    EXPECT_TRUE(space.contains(sub)) << subnet_key(sub);
+    EXPECT_EQ(space.sample(rng, ShrinkLimits{0, 0}), space.full());
+  }
+  SubnetConfig odd = space.full();
+  odd.widths["features"] = 27;
+  odd.blocks = {0};
+  const auto fixed = space.repair(odd);
+  EXPECT_TRUE(space.contains(fixed));
+  EXPECT_EQ(fixed.widths.at("features"), 28);
+  EXPECT_EQ(fixed.blocks, (std::vector<int>{0, 3}));
+}
+
+TEST(ElasticSpace, MakeElasticSortsChannelsAndKeepsTheOutput) {
+  const ArchSpec spec = small_pan();
+  SRNetwork net = test::build_network(spec, 6);
+  ElasticNetwork elastic = make_elastic(*net, ElasticOptions{});
+  const auto [color, info] = test::random_inputs(spec, 8, 8);
+  torch::NoGradGuard no_grad;
+  EXPECT_LT((elastic.network->forward(color, info) - net->forward(color, info)).abs().max().item<double>(), 1e-5);
+  for (const auto& [group, scores] : elastic.network->channel_importance()) {
+    const auto s = scores.detach();
+    for (int64_t i = 0; i + 1 < s.numel(); ++i) EXPECT_GE(s[i].item<double>(), s[i + 1].item<double>()) << group;
+  }
+  const auto back = elastic_space_from(spec, {{"elastic", elastic_metadata(elastic.space)}}, "test");
+  EXPECT_EQ(back.block_order(), elastic.space.block_order());
+  EXPECT_THROW(elastic_space_from(spec, nlohmann::ordered_json::object(), "test"), Error);
+}
+
+}  // namespace
+}  // namespace cgsr
