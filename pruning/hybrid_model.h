@@ -19,7 +19,7 @@
 namespace cgsr {
 
 // Each pattern's latency on the machine that pruned the model, at one input size.
-struct LatencyTable {
+struct PatternLatency {
   int64_t lr_width = 0, lr_height = 0;
   std::vector<double> median_ms;  // [pattern]
 };
@@ -28,7 +28,7 @@ struct HybridModel {
   SRNetwork network{nullptr};  // statically pruned (the widest pattern); runs dense on its own
   PatternPool pool;            // nested patterns of the network
   DynamicSamplers samplers{nullptr};  // one head scoring the pool's patterns
-  LatencyTable latency;
+  PatternLatency latency;
   Provenance provenance;
 };
 
