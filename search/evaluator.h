@@ -1,46 +1,31 @@
 #pragma once
-// What a search strategy knows about a candidate: its spec in, scores out. The search command
-// implements this with the trainer (warm start, a few epochs, validation); the search itself
-// never sees training, so candidates could as well be evaluated on other machines.
+// What the search knows about a subnet: its config in, scores out. The inference evaluator
+// (subnet_evaluator.h) scores subnets of a trained elastic network without training them; tests
+// inject their own.
 
-#include <functional>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <vector>
 
 #include "core/json_fields.h"
-#include "models/arch_spec.h"
+#include "models/subnet.h"
 
 namespace cgsr {
 
-struct CandidateScore {
-  double val_psnr = 0, val_ssim = 0;
-  double image_loss = 0, geometry_loss = 0;  // validation loss terms (the joint objective)
-  int64_t params = 0, macs = 0;              // inference network, at the evaluation LR size
-  std::optional<double> latency_ms;          // measured when the fitness asks for it
-  double train_seconds = 0;
+struct SubnetScore {
+  double psnr = 0;                   // on the validation crops (dB)
+  std::optional<double> psnr_edge;   // on their geometry-edge pixels, when the data has edges
+  double latency_ms = 0;             // predicted by the latency table
+  int64_t params = 0, macs = 0;      // inference network, MACs at the table's LR size
 };
-
-// A search history line's and a distributed reply's "score"; latency_ms is null when not measured.
-CGSR_JSON_FIELDS(CandidateScore, val_psnr, val_ssim, image_loss, geometry_loss, params, macs, latency_ms, train_seconds)
+CGSR_JSON_FIELDS(SubnetScore, psnr, psnr_edge, latency_ms, params, macs)
 
 class Evaluator {
  public:
   virtual ~Evaluator() = default;
-  // Trains (warm start from the parent) and validates one candidate. Must be deterministic for
-  // a given spec, so that a resumed search reaches the same result.
-  virtual CandidateScore evaluate(const ArchSpec& spec) = 0;
-  // The parent itself, given exactly a candidate's treatment (same training, same validation),
-  // so the pick rule compares like with like.
-  virtual CandidateScore evaluate_parent() = 0;
-  // The parent's blocks, least important first (models/block_importance.h): the order in which
-  // shallower candidates drop them. Empty: the last block first.
-  virtual std::vector<int> block_drop_order() const { return {}; }
-  // A generation's new candidates: reports each score as done(index, score), in index order
-  // (the order the history records). By default one after another in this process; a
-  // distributed evaluator spreads them over processes (cli/distributed_search.h).
-  virtual void evaluate_batch(const std::vector<ArchSpec>& specs,
-                              const std::function<void(size_t index, const CandidateScore& score)>& done);
+  // Deterministic for a given subnet, so that a resumed search reaches the same result. A
+  // subnet that cannot be scored (its output is not finite) throws cgsr::Error.
+  virtual SubnetScore evaluate(const SubnetConfig& subnet) = 0;
 };
 
 }  // namespace cgsr

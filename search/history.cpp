@@ -27,11 +27,13 @@ SearchHistory::SearchHistory(std::filesystem::path path, bool resume) : path_(st
     }
     try {
       const auto j = nlohmann::json::parse(text.substr(start, end - start));
-      HistoryEntry e;
+      Candidate e;
+      const std::string where = path_.string() + ":" + std::to_string(line_number);
       e.generation = j.at("generation");
-      e.spec = spec_from_yaml(j.at("spec").get<std::string>(), path_.string() + ":" + std::to_string(line_number));
+      e.subnet = subnet_from_json(j.at("subnet"), where);
       e.key = j.at("key");
-      e.score = j.at("score").get<CandidateScore>();
+      e.failed = j.at("failed");
+      if (!e.failed) e.score = j.at("score").get<SubnetScore>();
       index_[e.key] = entries_.size();
       entries_.push_back(std::move(e));
       valid_end = end + 1;
@@ -46,28 +48,34 @@ SearchHistory::SearchHistory(std::filesystem::path path, bool resume) : path_(st
   }
 }
 
-const HistoryEntry* SearchHistory::find(const std::string& key) const {
+const Candidate* SearchHistory::find(const std::string& key) const {
   const auto it = index_.find(key);
   return it == index_.end() ? nullptr : &entries_[it->second];
 }
 
-void SearchHistory::append(const HistoryEntry& entry) {
-  nlohmann::ordered_json j;
-  j["generation"] = entry.generation;
-  j["key"] = entry.key;
-  j["spec"] = spec_to_yaml(entry.spec);
-  j["summary"] = spec_summary(entry.spec);
-  j["score"] = entry.score;
-  const std::string line = j.dump() + "\n";
-  // One write of a whole line, then fsync: a kill leaves at most one partial last line.
+void SearchHistory::append(const std::vector<Candidate>& candidates) {
+  if (candidates.empty()) return;
+  std::string text;
+  for (const auto& c : candidates) {
+    nlohmann::ordered_json j;
+    j["generation"] = c.generation;
+    j["key"] = c.key;
+    j["subnet"] = to_json(c.subnet);
+    j["failed"] = c.failed;
+    if (!c.failed) j["score"] = c.score;
+    text += j.dump() + "\n";
+  }
+  // One write, then fsync: a kill leaves at most one partial last line.
   const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd < 0) throw Error(path_.string(), "cannot open the history for appending");
-  const ssize_t written = ::write(fd, line.data(), line.size());
+  const ssize_t written = ::write(fd, text.data(), text.size());
   ::fsync(fd);
   ::close(fd);
-  if (written != static_cast<ssize_t>(line.size())) throw Error(path_.string(), "write failed (disk full?)");
-  index_[entry.key] = entries_.size();
-  entries_.push_back(entry);
+  if (written != static_cast<ssize_t>(text.size())) throw Error(path_.string(), "write failed (disk full?)");
+  for (const auto& c : candidates) {
+    index_[c.key] = entries_.size();
+    entries_.push_back(c);
+  }
 }
 
 }  // namespace cgsr

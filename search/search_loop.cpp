@@ -4,177 +4,181 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <set>
 
+#include "core/error.h"
 #include "core/pareto.h"
 #include "core/progress.h"
 #include "core/runtime.h"
 
 namespace cgsr {
 
-// Before each strategy had its own options block, evolution's options were a shared `operators:`
-// block next to `strategy: evolution`; they now sit in the strategy block.
-YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cursor& at) {
-  if (!map || !map.IsMap() || !map["operators"] || !map["operators"].IsMap()) return map;
-  const YAML::Node operators = map["operators"];
-  YAML::Node strategy(YAML::NodeType::Map);
-  const YAML::Node given = map["strategy"];
-  if (given && given.IsMap())
-    for (const auto& kv : given) strategy.force_insert(kv.first, kv.second);
-  else
-    strategy["type"] = given && given.IsScalar() ? given : YAML::Node("evolution");
-  const bool evolution = strategy["type"].IsScalar() && strategy["type"].Scalar() == "evolution";
-  const std::string where = at.doc ? at.doc->locate(operators) : at.child("operators").path;
-  config::warn_deprecated(where, "'" + at.child("operators").path + "' is deprecated: " +
-                                     (evolution ? "write its keys in the strategy block, '" + at.child("strategy").path +
-                                                      ": {type: evolution, mutation_rate: ...}'"
-                                                : std::string("only the evolution strategy has these options; they are ignored")));
-  if (evolution)
-    for (const auto& kv : operators) strategy.force_insert(kv.first, kv.second);
+const std::vector<std::string>& EnumNames<FailurePolicy>::names() {
+  static const std::vector<std::string> names = {"worst", "retry", "abort"};
+  return names;
+}
 
-  YAML::Node out(YAML::NodeType::Map);
-  for (const auto& kv : map) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "";
-    if (key == "operators") continue;
-    out.force_insert(kv.first, key == "strategy" ? strategy : kv.second);
+namespace {
+config::Schema<FailureOptions> failure_schema() {
+  config::Schema<FailureOptions> s;
+  s.field("score", &FailureOptions::score,
+          "a subnet that cannot be scored: worst (never survives), retry (once more, then worst) or abort");
+  return s;
+}
+
+constexpr double kFailed = -std::numeric_limits<double>::infinity();
+
+// The population sorted best first: Pareto rank on (latency, quality), then crowding (lonelier first).
+std::vector<Candidate> rank_population(std::vector<Candidate> pool, size_t keep) {
+  std::vector<Candidate> alive;
+  for (auto& c : pool)
+    if (!c.failed) alive.push_back(std::move(c));
+  std::vector<double> cost, quality;
+  for (const auto& c : alive) {
+    cost.push_back(c.score.latency_ms);
+    quality.push_back(c.quality);
   }
-  if (!given) out["strategy"] = strategy;
+  const auto rank = pareto_ranks(cost, quality);
+  std::vector<double> crowd(alive.size(), 0);
+  const int fronts = alive.empty() ? 0 : *std::max_element(rank.begin(), rank.end()) + 1;
+  for (int r = 0; r < fronts; ++r) {
+    std::vector<size_t> members;
+    for (size_t i = 0; i < alive.size(); ++i)
+      if (rank[i] == r) members.push_back(i);
+    const auto d = crowding_distance(members, cost, quality);
+    for (size_t k = 0; k < members.size(); ++k) crowd[members[k]] = d[k];
+  }
+  std::vector<size_t> order(alive.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return rank[a] != rank[b] ? rank[a] < rank[b] : crowd[a] > crowd[b];
+  });
+  std::vector<Candidate> out;
+  for (size_t k = 0; k < order.size() && out.size() < keep; ++k) out.push_back(alive[order[k]]);
   return out;
 }
+}  // namespace
 
 config::Schema<SearchOptions> search_schema() {
   config::Schema<SearchOptions> s;
   s.field("strategy", &SearchOptions::strategy,
-          "proposes the candidates: {type: evolution, initial_spread, mutation_rate, crossover_rate} or {type: random}"
-          " (a bare name takes the strategy's defaults)");
-  s.field("population", &SearchOptions::population, "P: new candidates per generation").range(1, 10000);
-  s.field("selection_ratio", &SearchOptions::selection_ratio, "H = ratio x P candidates survive").range(0.01, 1.0);
-  s.field("generations", &SearchOptions::generations, "generation limit").range(1, 10000);
-  s.field("min_candidates", &SearchOptions::min_candidates, "stop when fewer unseen candidates remain").at_least(1);
-  s.field("tolerance_db", &SearchOptions::tolerance_db, "pick: validation PSNR within this of the parent").at_least(0);
-  s.section("space", &SearchOptions::space, search_space_schema(), "what the search may change");
-  s.section("fitness", &SearchOptions::fitness, fitness_schema(), "how candidates are ranked");
-  s.upgrade(move_operators_into_strategy);
+          "proposes the subnets: {type: evolution, mutation_rate, crossover_rate} or random");
+  s.field("population", &SearchOptions::population, "P: new subnets per generation, and the population kept")
+      .range(2, 100000);
+  s.field("generations", &SearchOptions::generations, "generations (P x generations evaluations)").range(1, 100000);
+  s.field("edge_weight", &SearchOptions::edge_weight, "weight of geometry-edge PSNR in the quality").range(0, 1);
+  s.section("on_failure", &SearchOptions::on_failure, failure_schema(), "what a subnet that cannot be scored does");
   return s;
 }
 
-Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& candidates,
-                         const SearchOptions& options, bool* is_parent) {
-  const Candidate* best = nullptr;
-  for (const auto& c : candidates) {
-    if (c.score.val_psnr < parent.score.val_psnr - options.tolerance_db) continue;
-    const double size = size_of(c.score, options.fitness.size_metric);
-    if (!best) {
-      best = &c;
-      continue;
-    }
-    const double best_size = size_of(best->score, options.fitness.size_metric);
-    if (size < best_size || (size == best_size && c.fitness < best->fitness)) best = &c;
-  }
-  if (is_parent) *is_parent = best == nullptr;
-  return best ? *best : parent;
+double candidate_quality(const SubnetScore& score, double edge_weight) {
+  if (edge_weight <= 0 || !score.psnr_edge) return score.psnr;
+  return (1 - edge_weight) * score.psnr + edge_weight * *score.psnr_edge;
 }
 
-std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates) {
-  std::vector<double> params, psnr;
-  for (const auto& c : candidates) {
-    params.push_back(static_cast<double>(c.score.params));
-    psnr.push_back(c.score.val_psnr);
-  }
-  std::vector<Candidate> front;
-  for (size_t i : cgsr::pareto_front(params, psnr)) front.push_back(candidates[i]);
-  std::stable_sort(front.begin(), front.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score.params < b.score.params; });
-  return front;
-}
-
-SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
-                        const SearchOptions& options) {
-  const SearchSpace space(parent_spec, options.space, evaluator.block_drop_order());
+SearchResult run_search(const ElasticSpace& space, Evaluator& evaluator, SearchHistory& history,
+                        const SearchOptions& options, const std::string& stream) {
   auto strategy = strategy_registry().get(options.strategy.type).make(space, options.strategy);
   SearchResult result;
-
-  // The parent, validated once: the reference for fitness and the pick rule.
-  const std::string parent_key = SearchSpace::key(space.parent());
-  result.parent.spec = space.parent();
-  result.parent.key = parent_key;
-  result.parent.generation = -1;
-  if (const auto* e = history.find(parent_key)) {
-    result.parent.score = e->score;
-  } else {
-    result.parent.score = evaluator.evaluate_parent();
-    history.append({-1, space.parent(), parent_key, result.parent.score});
-  }
-  result.parent.fitness = fitness(result.parent.score, result.parent.score, options.fitness);
-  spdlog::info("search: parent {} validates at {:.3f} dB with {} params", spec_summary(space.parent()),
-               result.parent.score.val_psnr, result.parent.score.params);
-
-  const int survivors_wanted = std::max(1, static_cast<int>(std::lround(options.selection_ratio * options.population)));
-  std::vector<Candidate> survivors;
-  std::set<std::string> evaluated_keys{parent_key};
-  auto seen = [&](const std::string& key) { return evaluated_keys.count(key) > 0; };
-
+  std::vector<Candidate> population;
+  std::set<std::string> evaluated_keys;
+  const auto seen = [&](const std::string& key) { return evaluated_keys.count(key) > 0; };
+  const std::string purpose = "search-" + stream;
   for (int generation = 0; generation < options.generations; ++generation) {
-    // Each generation draws from its own stream: a resumed search proposes the same specs.
-    auto rng = make_rng("search-generation", static_cast<uint64_t>(generation));
-    const auto proposals = strategy->propose(survivors, options.population, seen, rng);
-    if (static_cast<int>(proposals.size()) < options.min_candidates) {
-      result.stop_reason = "only " + std::to_string(proposals.size()) + " unseen candidate(s) left in generation " +
+    auto rng = make_rng(purpose.c_str(), static_cast<uint64_t>(generation));
+    const auto proposals = strategy->propose(population, options.population, seen, rng);
+    if (proposals.size() < 2) {
+      result.stop_reason = "only " + std::to_string(proposals.size()) + " unseen subnet(s) left in generation " +
                            std::to_string(generation);
       break;
     }
-    Progress progress("search generation " + std::to_string(generation), static_cast<int64_t>(proposals.size()));
-    std::vector<Candidate> generation_candidates(proposals.size());
-    std::vector<ArchSpec> to_evaluate;
-    std::vector<size_t> slots;  // generation_candidates index of each spec in to_evaluate
-    const auto report = [&](const Candidate& c) {
-      progress.set_status(spec_summary(c.spec) + " " + std::to_string(c.score.val_psnr).substr(0, 6) + " dB");
-      progress.advance();
-    };
-    for (size_t i = 0; i < proposals.size(); ++i) {
-      Candidate& c = generation_candidates[i];
-      c.spec = proposals[i];
-      c.key = SearchSpace::key(c.spec);
+    Progress progress(stream + " generation " + std::to_string(generation), static_cast<int64_t>(proposals.size()));
+    std::vector<Candidate> fresh, news;
+    for (const auto& sub : proposals) {
+      Candidate c;
+      c.subnet = sub;
+      c.key = subnet_key(sub);
       c.generation = generation;
       if (const auto* e = history.find(c.key)) {
-        c.score = e->score;  // evaluated before an interruption
-        report(c);
+        c = *e;  // scored before an interruption
+        c.generation = generation;
       } else {
-        to_evaluate.push_back(c.spec);
-        slots.push_back(i);
+        for (int attempt = 0;; ++attempt) {
+          try {
+            c.score = evaluator.evaluate(sub);
+            c.failed = false;
+            break;
+          } catch (const Error& e) {
+            if (options.on_failure.score == FailurePolicy::Abort) throw;
+            c.failed = true;
+            if (options.on_failure.score == FailurePolicy::Worst || attempt >= 1) {
+              spdlog::warn("{}: {}; scored as the worst", c.key, e.what());
+              break;
+            }
+            spdlog::warn("{}: {}; retrying once", c.key, e.what());
+          }
+        }
+        fresh.push_back(c);
       }
-    }
-    // In proposal order, so the history reads the same however the evaluator spreads the work.
-    evaluator.evaluate_batch(to_evaluate, [&](size_t k, const CandidateScore& score) {
-      Candidate& c = generation_candidates[slots[k]];
-      c.score = score;
-      history.append({generation, c.spec, c.key, c.score});
-      report(c);
-    });
-    for (auto& c : generation_candidates) {
-      c.fitness = fitness(c.score, result.parent.score, options.fitness);
+      c.quality = c.failed ? kFailed : candidate_quality(c.score, options.edge_weight);
+      if (c.failed) ++result.failures;
       evaluated_keys.insert(c.key);
-      result.evaluated.push_back(c);
+      news.push_back(c);
+      progress.advance();
     }
+    history.append(fresh);
     progress.finish();
-
-    survivors.insert(survivors.end(), generation_candidates.begin(), generation_candidates.end());
-    std::stable_sort(survivors.begin(), survivors.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.fitness < b.fitness; });
-    if (static_cast<int>(survivors.size()) > survivors_wanted) survivors.resize(survivors_wanted);
+    result.evaluated.insert(result.evaluated.end(), news.begin(), news.end());
+    std::vector<Candidate> pool = population;
+    pool.insert(pool.end(), news.begin(), news.end());
+    population = rank_population(std::move(pool), static_cast<size_t>(options.population));
     result.generations_run = generation + 1;
-
-    bool none = false;
-    const Candidate best_so_far = pick_candidate(result.parent, result.evaluated, options, &none);
-    spdlog::info("generation {}: {} candidates, best fitness {:.4f} ({:.3f} dB, {} params); pick so far: {}", generation,
-                 generation_candidates.size(), survivors.front().fitness, survivors.front().score.val_psnr,
-                 survivors.front().score.params,
-                 none ? std::string("the parent (no candidate within tolerance)")
-                      : spec_summary(best_so_far.spec) + " with " + std::to_string(best_so_far.score.params) + " params");
+    const auto front = latency_front(result.evaluated);
+    if (!front.empty())
+      spdlog::info("{} generation {}: {} subnets; front of {} from {:.1f} ms / {:.3f} dB to {:.1f} ms / {:.3f} dB", stream,
+                   generation, news.size(), front.size(), front.front().score.latency_ms, front.front().quality,
+                   front.back().score.latency_ms, front.back().quality);
   }
   if (result.stop_reason.empty()) result.stop_reason = "generation limit " + std::to_string(options.generations);
-  result.pick = pick_candidate(result.parent, result.evaluated, options, &result.pick_is_parent);
+  result.front = latency_front(result.evaluated);
   return result;
+}
+
+std::vector<Candidate> latency_front(const std::vector<Candidate>& candidates) {
+  std::vector<Candidate> alive;
+  for (const auto& c : candidates)
+    if (!c.failed) alive.push_back(c);
+  std::vector<double> cost, quality;
+  for (const auto& c : alive) {
+    cost.push_back(c.score.latency_ms);
+    quality.push_back(c.quality);
+  }
+  std::vector<Candidate> front;
+  std::set<std::string> keys;
+  for (size_t i : pareto_front(cost, quality))
+    if (keys.insert(alive[i].key).second) front.push_back(alive[i]);
+  std::stable_sort(front.begin(), front.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score.latency_ms < b.score.latency_ms; });
+  return front;
+}
+
+const Candidate& pick_within(const std::vector<Candidate>& front, double budget_ms) {
+  if (front.empty()) throw Error("search", "no subnet was scored");
+  const Candidate* best = nullptr;
+  for (const auto& c : front)
+    if (c.score.latency_ms <= budget_ms && (!best || c.quality > best->quality)) best = &c;
+  return best ? *best : front.front();
+}
+
+double front_hypervolume(const std::vector<Candidate>& front, double latency_ref, double quality_ref) {
+  std::vector<double> cost, quality;
+  for (const auto& c : front) {
+    cost.push_back(c.score.latency_ms);
+    quality.push_back(c.quality);
+  }
+  return hypervolume(cost, quality, latency_ref, quality_ref);
 }
 
 }  // namespace cgsr

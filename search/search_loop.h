@@ -1,60 +1,70 @@
 #pragma once
-// The generation loop of the CG-guided architecture search (CGSR Eq. 1 and "Dataset and
-// Implementation"): each generation the strategy proposes P new candidates, the evaluator trains
-// and validates them, and the H = selection_ratio x P best by fitness (among survivors and new
-// candidates) survive. The loop stops after `generations`, or when the strategy finds fewer than
-// `min_candidates` unseen specs (the space is exhausted).
+// The generation loop of the subnet search (CGSR's CG-guided NAS, run over the subnets of one
+// elastic network): each generation the strategy proposes P new subnets, the evaluator scores
+// them by inference, and the P best of the population and the new ones by Pareto rank on
+// (quality, predicted latency), then crowding, form the next population (NSGA-II). The loop
+// stops after `generations`, or when the strategy finds fewer than 2 unseen subnets.
 //
-// The pick: the smallest candidate (by the fitness' size metric) whose validation PSNR is within
-// `tolerance_db` of the parent's; ties go to the better fitness. When no candidate qualifies the
-// parent itself is the pick, and the result says so. Size alone never decides.
+// Quality is validation PSNR, or (1 - edge_weight) PSNR + edge_weight edge PSNR when the data
+// has edges: how much the geometry edges, where networks lose most, weigh in the choice.
+//
+// A subnet that cannot be scored (a non-finite output) does what `on_failure.score` says:
+// worst (it gets the worst quality and never survives), retry (evaluated once more, then worst)
+// or abort (the search stops with the error).
 
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "core/config.h"
+#include "core/enum_names.h"
 #include "search/evaluator.h"
-#include "search/fitness.h"
 #include "search/history.h"
-#include "search/search_space.h"
 #include "search/strategy.h"
 
 namespace cgsr {
 
+enum class FailurePolicy { Worst, Retry, Abort };
+template <>
+struct EnumNames<FailurePolicy> {
+  static constexpr const char* kind = "failure policy";
+  static const std::vector<std::string>& names();  // worst, retry, abort
+};
+
+struct FailureOptions {
+  FailurePolicy score = FailurePolicy::Worst;
+};
+
 struct SearchOptions {
-  StrategyOptions strategy;       // {type: evolution, ...its options} or a bare name
-  int population = 50;            // P: new candidates per generation
-  double selection_ratio = 0.2;   // H = ratio x P survive
-  int generations = 10;
-  int min_candidates = 2;
-  double tolerance_db = 0.05;     // pick rule: PSNR within this of the parent
-  SearchSpaceOptions space;
-  FitnessOptions fitness;
+  StrategyOptions strategy;   // {type: evolution, ...its options} or a bare name
+  int population = 50;        // P: new subnets per generation, and the population kept
+  int generations = 20;
+  double edge_weight = 0;     // of edge PSNR in the quality
+  FailureOptions on_failure;
 };
 config::Schema<SearchOptions> search_schema();
-// The former shape, `strategy: evolution` with a shared `operators: {...}` block, rewritten into
-// the strategy block (with a deprecation warning). search_schema() applies it, and so does a
-// schema that inlines the search options (config::Schema::inline_section carries upgrades).
-YAML::Node move_operators_into_strategy(const YAML::Node& map, const config::Cursor& at);
 
 struct SearchResult {
-  Candidate parent;
-  std::vector<Candidate> evaluated;  // every candidate of this search, in evaluation order
-  Candidate pick;
-  bool pick_is_parent = false;
+  std::vector<Candidate> evaluated;  // every subnet of this search, in evaluation order
+  std::vector<Candidate> front;      // Pareto front of quality against latency, fastest first
   int generations_run = 0;
+  int failures = 0;
   std::string stop_reason;
 };
 
-Candidate pick_candidate(const Candidate& parent, const std::vector<Candidate>& candidates,
-                         const SearchOptions& options, bool* is_parent);
+// `stream` names the search's random stream ("evolution", "random"): two searches with one seed
+// but other streams draw differently, a resumed one the same.
+SearchResult run_search(const ElasticSpace& space, Evaluator& evaluator, SearchHistory& history,
+                        const SearchOptions& options, const std::string& stream);
 
-// The candidates no other candidate beats on both size (params) and validation PSNR, smallest
-// first: what a search found, beyond its one pick.
-std::vector<Candidate> pareto_front(const std::vector<Candidate>& candidates);
+double candidate_quality(const SubnetScore& score, double edge_weight);
 
-SearchResult run_search(const ArchSpec& parent_spec, Evaluator& evaluator, SearchHistory& history,
-                        const SearchOptions& options);
+// The candidates no other beats on both predicted latency and quality, fastest first.
+std::vector<Candidate> latency_front(const std::vector<Candidate>& candidates);
+
+// The best quality on `front` within `budget_ms` of predicted latency; the fastest when none fits.
+const Candidate& pick_within(const std::vector<Candidate>& front, double budget_ms);
+
+// The front's hypervolume against (latency_ref, quality_ref) (core/pareto.h).
+double front_hypervolume(const std::vector<Candidate>& front, double latency_ref, double quality_ref);
 
 }  // namespace cgsr

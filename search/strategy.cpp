@@ -1,69 +1,69 @@
+#include "search/strategy.h"
+
+#include <algorithm>
 #include <set>
 
-#include "search/strategy.h"
+#include "search/genetic_operators.h"
 
 namespace cgsr {
 
 config::Schema<EvolutionOptions> evolution_schema() {
   config::Schema<EvolutionOptions> s;
-  s.field("initial_spread", &EvolutionOptions::initial_spread, "per-gene mutation rate of the first generation")
-      .range(0, 1);
   s.field("mutation_rate", &EvolutionOptions::mutation_rate, "per-gene mutation rate").range(0, 1);
   s.field("crossover_rate", &EvolutionOptions::crossover_rate, "share of children made by crossover").range(0, 1);
   return s;
 }
 
 namespace {
-// Draws specs until `count` new ones are found or attempts run out (the space is exhausted).
-std::vector<ArchSpec> collect(int count, const SearchSpace& space, const std::function<bool(const std::string&)>& seen,
-                              const std::function<ArchSpec()>& draw) {
-  std::vector<ArchSpec> out;
+// Draws subnets until `count` new ones are found or attempts run out (the space is exhausted).
+std::vector<SubnetConfig> collect(int count, const std::function<bool(const std::string&)>& seen,
+                                  const std::function<SubnetConfig()>& draw) {
+  std::vector<SubnetConfig> out;
   std::set<std::string> taken;
   const int max_attempts = 50 * std::max(1, count);
   for (int attempt = 0; attempt < max_attempts && static_cast<int>(out.size()) < count; ++attempt) {
-    ArchSpec spec = draw();
-    if (!space.contains(spec)) continue;
-    const std::string key = SearchSpace::key(spec);
+    SubnetConfig sub = draw();
+    const std::string key = subnet_key(sub);
     if (seen(key) || !taken.insert(key).second) continue;
-    out.push_back(std::move(spec));
+    out.push_back(std::move(sub));
   }
   return out;
 }
 
 class Evolution : public SearchStrategy {
  public:
-  Evolution(const SearchSpace& space, EvolutionOptions options) : space_(space), options_(options) {}
-  std::vector<ArchSpec> propose(const std::vector<Candidate>& survivors, int count,
-                                const std::function<bool(const std::string&)>& seen, std::mt19937_64& rng) override {
+  Evolution(const ElasticSpace& space, EvolutionOptions options) : space_(space), options_(options) {}
+  std::vector<SubnetConfig> propose(const std::vector<Candidate>& population, int count,
+                                    const std::function<bool(const std::string&)>& seen,
+                                    std::mt19937_64& rng) override {
+    if (population.empty()) return collect(count, seen, [&] { return space_.sample(rng); });
     std::uniform_real_distribution<double> u(0, 1);
-    return collect(count, space_, seen, [&] {
-      if (survivors.empty()) return space_.mutate(space_.parent(), options_.initial_spread, rng);
-      std::uniform_int_distribution<size_t> pick(0, survivors.size() - 1);
-      if (survivors.size() >= 2 && u(rng) < options_.crossover_rate) {
-        const size_t a = pick(rng);
-        size_t b = pick(rng);
-        while (b == a) b = pick(rng);
-        return space_.mutate(space_.crossover(survivors[a].spec, survivors[b].spec, rng), options_.mutation_rate, rng);
-      }
-      return space_.mutate(survivors[pick(rng)].spec, options_.mutation_rate, rng);
+    std::uniform_int_distribution<size_t> pick(0, population.size() - 1);
+    // Binary tournament: the population is sorted best first, so the lower index wins.
+    const auto parent = [&]() -> const SubnetConfig& { return population[std::min(pick(rng), pick(rng))].subnet; };
+    return collect(count, seen, [&] {
+      if (population.size() >= 2 && u(rng) < options_.crossover_rate)
+        return mutate(space_, crossover(space_, parent(), parent(), rng), options_.mutation_rate, rng);
+      return mutate(space_, parent(), options_.mutation_rate, rng);
     });
   }
 
  private:
-  const SearchSpace& space_;
+  const ElasticSpace& space_;
   EvolutionOptions options_;
 };
 
 class RandomSearch : public SearchStrategy {
  public:
-  explicit RandomSearch(const SearchSpace& space) : space_(space) {}
-  std::vector<ArchSpec> propose(const std::vector<Candidate>&, int count,
-                                const std::function<bool(const std::string&)>& seen, std::mt19937_64& rng) override {
-    return collect(count, space_, seen, [&] { return space_.sample(rng); });
+  explicit RandomSearch(const ElasticSpace& space) : space_(space) {}
+  std::vector<SubnetConfig> propose(const std::vector<Candidate>&, int count,
+                                    const std::function<bool(const std::string&)>& seen,
+                                    std::mt19937_64& rng) override {
+    return collect(count, seen, [&] { return space_.sample(rng); });
   }
 
  private:
-  const SearchSpace& space_;
+  const ElasticSpace& space_;
 };
 }  // namespace
 
@@ -77,10 +77,10 @@ const Registry<StrategyType>& strategy_registry() {
            [](const StrategyOptions& o, YAML::Node& block) {
              for (const auto& kv : evolution_schema().emit(o.evolution)) block[kv.first] = kv.second;
            },
-           [](const SearchSpace& space, const StrategyOptions& o) {
+           [](const ElasticSpace& space, const StrategyOptions& o) {
              return std::make_unique<Evolution>(space, o.evolution);
            }},
-          "mutation and crossover of the survivors (CGSR)");
+          "NSGA-II: tournament on Pareto rank and crowding, crossover and mutation (CGSR)");
     r.add("random",
           {[](const YAML::Node& block, StrategyOptions&, const config::Cursor& at) {
              for (const auto& kv : block)
@@ -88,7 +88,7 @@ const Registry<StrategyType>& strategy_registry() {
                  at.fail(kv.first, "the random strategy has no options; only 'type' belongs here");
            },
            [](const StrategyOptions&, YAML::Node&) {},
-           [](const SearchSpace& space, const StrategyOptions&) { return std::make_unique<RandomSearch>(space); }},
+           [](const ElasticSpace& space, const StrategyOptions&) { return std::make_unique<RandomSearch>(space); }},
           "uniform samples of the search space (baseline)");
     return r;
   }();

@@ -1,10 +1,11 @@
 #pragma once
-// Search strategies propose new specs from the survivors of the previous generation: selection,
-// mutation and crossover live here, the generation loop (search/search_loop.h) keeps the
-// generations, history and pick. They see specs and fitness values only (search/evaluator.h);
-// a registry builds them by name, each with its own options block:
-//   evolution  mutation and crossover of the survivors' genes (the CGSR search)
-//   random     specs drawn uniformly from the space (the baseline at equal budget)
+// Search strategies propose new subnets from the current population; the generation loop
+// (search/search_loop.h) evaluates them and keeps the population. They see subnets and scores
+// only. A registry builds them by name, each with its own options block:
+//   evolution  NSGA-II: parents by binary tournament on Pareto rank and crowding, uniform
+//              crossover, then per-gene mutation (the CGSR search, multi-objective)
+//   random     subnets drawn uniformly from the space (the baseline at equal evaluations)
+// Both start from the same first generation: uniform samples of the space.
 
 #include <functional>
 #include <memory>
@@ -14,24 +15,24 @@
 
 #include "core/config.h"
 #include "core/registry.h"
+#include "models/elastic.h"
 #include "search/evaluator.h"
-#include "search/search_space.h"
 
 namespace cgsr {
 
 struct Candidate {
-  ArchSpec spec;
+  SubnetConfig subnet;
   std::string key;
-  CandidateScore score;
-  double fitness = 0;
+  SubnetScore score;
+  double quality = 0;    // what the search maximizes (search_loop.h); -inf for a failed candidate
   int generation = 0;
+  bool failed = false;   // could not be scored (on_failure: worst)
 };
 
-// Options of the evolution strategy (the CGSR search).
+// Options of the evolution strategy.
 struct EvolutionOptions {
-  double initial_spread = 0.5;  // mutation rate that draws the first generation around the parent
-  double mutation_rate = 0.15;  // per gene
-  double crossover_rate = 0.5;  // share of children made by crossover of two survivors
+  double mutation_rate = 0.1;   // per gene
+  double crossover_rate = 0.5;  // share of children made by crossover of two parents
 };
 config::Schema<EvolutionOptions> evolution_schema();
 
@@ -45,25 +46,26 @@ struct StrategyOptions {
 class SearchStrategy {
  public:
   virtual ~SearchStrategy() = default;
-  // Up to `count` specs in the space, none of which `seen`, none twice; fewer when the space
-  // offers no more. `survivors` are sorted best first (empty before the first generation).
-  virtual std::vector<ArchSpec> propose(const std::vector<Candidate>& survivors, int count,
-                                        const std::function<bool(const std::string&)>& seen,
-                                        std::mt19937_64& rng) = 0;
+  // Up to `count` subnets of the space, none of which `seen`, none twice; fewer when the space
+  // offers no more. `population` is sorted best first (Pareto rank, then crowding; empty before
+  // the first generation).
+  virtual std::vector<SubnetConfig> propose(const std::vector<Candidate>& population, int count,
+                                            const std::function<bool(const std::string&)>& seen,
+                                            std::mt19937_64& rng) = 0;
 };
 
 // A strategy by name: how its options block is read and written, and the factory.
 struct StrategyType {
   std::function<void(const YAML::Node& block, StrategyOptions& options, const config::Cursor& at)> parse_options;
   std::function<void(const StrategyOptions& options, YAML::Node& block)> emit_options;
-  std::function<std::unique_ptr<SearchStrategy>(const SearchSpace& space, const StrategyOptions& options)> make;
+  std::function<std::unique_ptr<SearchStrategy>(const ElasticSpace& space, const StrategyOptions& options)> make;
 };
 const Registry<StrategyType>& strategy_registry();
 
 }  // namespace cgsr
 
 namespace cgsr::config {
-// `strategy:` as a bare name or a {type: Name, ...its options} block; written as the block.
+// `strategy:` as a bare name or a {type: Name, ...} block; written as the block.
 template <>
 struct Codec<StrategyOptions> {
   static StrategyOptions decode(const YAML::Node& n, const Cursor& at);

@@ -1,0 +1,19 @@
+#pragma once
+// Mutation and crossover of subnets (models/subnet.h) inside an elastic space: the genes are the
+// width of every elastic layer group and whether each residual block is kept. Results are
+// repaired into the space (allowed widths, enough blocks).
+
+#include <random>
+
+#include "models/elastic.h"
+
+namespace cgsr {
+
+// Each gene changes with probability `rate`: a width moves one allowed step up or down, a block
+// is dropped or restored.
+SubnetConfig mutate(const ElasticSpace& space, const SubnetConfig& sub, double rate, std::mt19937_64& rng);
+
+// Each gene comes from `a` or `b` with equal probability.
+SubnetConfig crossover(const ElasticSpace& space, const SubnetConfig& a, const SubnetConfig& b, std::mt19937_64& rng);
+
+}  // namespace cgsr
