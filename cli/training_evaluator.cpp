@@ -9,8 +9,9 @@
 #include "core/runtime.h"
 #include "core/timing.h"
 #include "models/backbone_registry.h"
-#include "models/block_importance.h"
 #include "models/complexity.h"
+#include "models/importance/block_importance.h"
+#include "models/importance/channel_importance.h"
 #include "models/inference.h"
 #include "models/inherit.h"
 #include "render_data/patch_sampler.h"
@@ -89,7 +90,7 @@ CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
     // those of the blocks it drops (groups it does not keep at all).
     ShrinkTargets shrink;
     const auto kept = inherit(*parent_, spec, {}, blocks).kept;
-    for (const auto& [group, importance] : parent_->channel_importance()) {
+    for (const auto& [group, importance] : channel_importance(*parent_)) {
       const auto keep = kept.find(group);
       if (keep == kept.end() && !parse_block_group(group)) continue;  // a group the candidate keeps whole
       std::vector<int64_t> dropped;

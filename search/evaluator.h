@@ -33,7 +33,7 @@ class Evaluator {
   // The parent itself, given exactly a candidate's treatment (same training, same validation),
   // so the pick rule compares like with like.
   virtual CandidateScore evaluate_parent() = 0;
-  // The parent's blocks, least important first (models/block_importance.h): the order in which
+  // The parent's blocks, least important first (models/importance/block_importance.h): the order in which
   // shallower candidates drop them. Empty: the last block first.
   virtual std::vector<int> block_drop_order() const { return {}; }
   // A generation's new candidates: reports each score as done(index, score), in index order

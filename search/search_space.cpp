@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "models/backbone_registry.h"
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
 #include "models/inherit.h"
 
 namespace cgsr {

@@ -8,7 +8,7 @@
 // wider or deeper than its parent, because its weights are inherited from the parent.
 //
 // A candidate with fewer blocks keeps the parent blocks a drop order spares
-// (models/block_importance.h: the least important go first), and its block genes are those of
+// (models/importance/block_importance.h: the least important go first), and its block genes are those of
 // the parent blocks it keeps: block i of a candidate is parent block parent_blocks(spec)[i].
 
 #include <map>

@@ -5,11 +5,11 @@
 
 #include "cli/distributed_run.h"
 #include "cli/distributed_search.h"
-#include "core/hash.h"
 #include "core/atomic_file.h"
+#include "core/hash.h"
 #include "core/plot.h"
 #include "core/yaml_json.h"
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
 #include "models/inherit.h"
 #include "models/model_file.h"
 #include "render_data/dataset.h"

@@ -8,7 +8,7 @@
 #include "cli/training_evaluator.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
 #include "search/search_space.h"
 #include "tests/support/tiny_data.h"
 

@@ -1,4 +1,4 @@
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
 
 #include <torch/torch.h>
 

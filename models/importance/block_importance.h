@@ -5,7 +5,7 @@
 // A block reads the residual stream and adds its branch back into it. Its importance is the L1
 // norm of the weights of its ops whose output lies on the stream (PAN's conv3, EDSR's conv2):
 // a block that writes little changes the stream little. A weight statistic, like the channel
-// importance of sr_network.h, so it needs no data and every caller computes the same order.
+// importance of channel_importance.h, so it needs no data and every caller computes the same order.
 //
 //   auto order = block_drop_order(*parent);     // parent blocks, least important first
 //   auto kept = kept_blocks(order, 12);          // the 12 a 12-block child keeps, ascending

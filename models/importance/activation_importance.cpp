@@ -1,4 +1,4 @@
-#include "pruning/activation_importance.h"
+#include "models/importance/activation_importance.h"
 
 #include <torch/torch.h>
 
@@ -6,13 +6,11 @@
 #include <set>
 
 #include "core/error.h"
-#include "train/losses.h"
 
 namespace cgsr {
 
-std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::vector<PrunableUnit>& units) {
-  std::set<std::string> dynamic;
-  for (const auto& u : units) dynamic.insert(u.groups.begin(), u.groups.end());
+std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::vector<std::string>& groups) {
+  const std::set<std::string> dynamic(groups.begin(), groups.end());
   std::set<int> conv_inputs;
   for (const auto& op : graph.ops)
     if (graph::op_traits(op.kind).mixes_channels) conv_inputs.insert(op.inputs[0]);
@@ -29,12 +27,11 @@ std::vector<size_t> conv_input_producers(const graph::Graph& graph, const std::v
   return out;
 }
 
-FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<PrunableUnit>& units,
+FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const std::vector<std::string>& groups,
                                  ActivationScore score) {
   const graph::Graph g = net.describe(false);
-  const auto producers = conv_input_producers(g, units);
-  std::set<std::string> dynamic;
-  for (const auto& u : units) dynamic.insert(u.groups.begin(), u.groups.end());
+  const auto producers = conv_input_producers(g, groups);
+  const std::set<std::string> dynamic(groups.begin(), groups.end());
 
   std::vector<std::pair<size_t, torch::Tensor>> captured;  // (op index, value)
   std::vector<bool> wanted(g.ops.size(), false);
@@ -58,7 +55,7 @@ FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const s
     const auto out = graph::run(g, inputs, nullptr, observe);
     if (taylor) {
       const auto image = out.front().second;
-      reconstruction_error(image, batch.hr_color, ErrorNorm::L2).backward();
+      torch::mse_loss(image, batch.hr_color).backward();  // the reconstruction loss L (L2)
     }
     torch::NoGradGuard no_grad_after;
     for (const auto& [index, value] : captured) {
@@ -87,12 +84,11 @@ FrameImportance frame_importance(SRNetworkImpl& net, const Batch& batch, const s
   for (auto& p : net.parameters()) p.mutable_grad() = torch::Tensor();
   if (was_training) net.train();
   FrameImportance out;
-  for (const auto& u : units)
-    for (size_t i = 0; i < u.groups.size(); ++i) {
-      const auto it = sums.find(u.groups[i]);
-      CGSR_CHECK(it != sums.end(), "importance: group " + u.groups[i] + " never reaches a convolution");
-      out[u.groups[i]] = (taylor ? it->second.abs() : it->second).to(torch::kFloat).contiguous();
-    }
+  for (const auto& group : groups) {
+    const auto it = sums.find(group);
+    CGSR_CHECK(it != sums.end(), "importance: group " + group + " never reaches a convolution");
+    out[group] = (taylor ? it->second.abs() : it->second).to(torch::kFloat).contiguous();
+  }
   return out;
 }
 
