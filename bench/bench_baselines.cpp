@@ -8,8 +8,8 @@
 #include <torch/torch.h>
 
 #include "core/runtime.h"
-#include "train/baselines/fsr1.h"
-#include "train/baselines/interpolation.h"
+#include "eval/baselines/fsr1.h"
+#include "eval/baselines/interpolation.h"
 
 namespace {
 

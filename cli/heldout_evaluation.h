@@ -15,8 +15,8 @@
 
 #include "cli/commands/render.h"
 #include "core/config.h"
+#include "eval/evaluation.h"
 #include "render_data/dataset.h"
-#include "train/evaluation.h"
 
 namespace cgsr::cli {
 

@@ -5,7 +5,7 @@
 #include <map>
 #include <optional>
 
-#include "train/pattern_choice.h"
+#include "eval/pattern_choice.h"
 
 namespace cgsr::cli {
 

@@ -23,7 +23,7 @@
 
 #include "core/config.h"
 #include "core/json_fields.h"
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 namespace cgsr::cli {
 

@@ -20,7 +20,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/yaml_json.h"
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 namespace {
 using namespace cgsr;

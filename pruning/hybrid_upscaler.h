@@ -12,9 +12,9 @@
 #include <chrono>
 #include <memory>
 
+#include "eval/upscaler.h"
 #include "pruning/hybrid_model.h"
 #include "pruning/pattern_networks.h"
-#include "train/upscaler.h"
 
 namespace cgsr {
 

@@ -6,10 +6,10 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "eval/pattern_choice.h"
 #include "pruning/hybrid_upscaler.h"
 #include "pruning/pattern_networks.h"
 #include "render_data/patch_sampler.h"
-#include "train/pattern_choice.h"
 
 namespace cgsr {
 

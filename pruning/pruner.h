@@ -26,6 +26,7 @@
 
 #include "core/config.h"
 #include "core/json_fields.h"
+#include "eval/evaluation.h"
 #include "models/importance/importance_methods.h"
 #include "models/model_file.h"
 #include "pruning/baseline_pruning.h"
@@ -34,7 +35,6 @@
 #include "pruning/pattern_pool.h"
 #include "pruning/static_pruning.h"
 #include "render_data/dataset.h"
-#include "train/evaluation.h"
 
 namespace cgsr {
 

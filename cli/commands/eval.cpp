@@ -6,10 +6,10 @@
 
 #include "core/atomic_file.h"
 #include "core/metrics.h"
+#include "eval/report.h"
 #include "models/model_file.h"
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
-#include "train/report.h"
 
 namespace cgsr::cli {
 

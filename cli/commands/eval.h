@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 namespace cgsr::cli {
 

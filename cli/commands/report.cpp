@@ -5,7 +5,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "train/pattern_choice.h"
+#include "eval/pattern_choice.h"
 
 namespace cgsr::cli {
 

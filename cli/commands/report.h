@@ -6,7 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
-#include "train/report.h"
+#include "eval/report.h"
 
 namespace cgsr::cli {
 

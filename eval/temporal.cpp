@@ -1,4 +1,4 @@
-#include "train/temporal.h"
+#include "eval/temporal.h"
 
 #include <torch/torch.h>
 

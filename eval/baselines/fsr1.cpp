@@ -1,4 +1,4 @@
-#include "train/baselines/fsr1.h"
+#include "eval/baselines/fsr1.h"
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>

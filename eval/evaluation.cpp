@@ -1,4 +1,4 @@
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
@@ -11,9 +11,9 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/progress.h"
+#include "eval/temporal.h"
 #include "render_data/edges.h"
 #include "render_data/patch_sampler.h"
-#include "train/temporal.h"
 
 namespace cgsr {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 namespace cgsr {
 

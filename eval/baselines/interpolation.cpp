@@ -1,4 +1,4 @@
-#include "train/baselines/interpolation.h"
+#include "eval/baselines/interpolation.h"
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>

@@ -15,8 +15,8 @@
 #include "core/config.h"
 #include "core/metrics.h"
 #include "core/timing.h"
+#include "eval/upscaler.h"
 #include "render_data/dataset.h"
-#include "train/upscaler.h"
 
 namespace cgsr {
 

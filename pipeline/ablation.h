@@ -26,10 +26,10 @@
 #include <vector>
 
 #include "core/config.h"
+#include "eval/evaluation.h"
 #include "models/arch_spec.h"
 #include "models/sr_network.h"
 #include "render_data/dataset.h"
-#include "train/evaluation.h"
 #include "train/losses.h"
 #include "train/trainer.h"
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "train/baselines/fsr1.h"
-#include "train/baselines/interpolation.h"
+#include "eval/baselines/fsr1.h"
+#include "eval/baselines/interpolation.h"
 
 using namespace cgsr;
 

@@ -1,4 +1,4 @@
-#include "train/pattern_choice.h"
+#include "eval/pattern_choice.h"
 
 #include <sstream>
 

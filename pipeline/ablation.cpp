@@ -1,4 +1,4 @@
-#include "train/ablation.h"
+#include "pipeline/ablation.h"
 
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
@@ -13,10 +13,10 @@
 #include "core/plot.h"
 #include "core/runtime.h"
 #include "core/text.h"
+#include "eval/upscaler.h"
 #include "models/complexity.h"
 #include "models/inherit.h"
 #include "models/model_file.h"
-#include "train/upscaler.h"
 
 namespace cgsr {
 

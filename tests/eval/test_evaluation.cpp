@@ -8,9 +8,9 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "eval/evaluation.h"
 #include "render_data/patch_sampler.h"
 #include "tests/support/tiny_data.h"
-#include "train/evaluation.h"
 
 using namespace cgsr;
 using namespace cgsr::test;

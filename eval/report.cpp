@@ -1,4 +1,4 @@
-#include "train/report.h"
+#include "eval/report.h"
 
 #include <algorithm>
 #include <cmath>

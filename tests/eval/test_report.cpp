@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "core/atomic_file.h"
-#include "train/report.h"
+#include "eval/report.h"
 
 using namespace cgsr;
 

@@ -4,10 +4,10 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "eval/upscaler.h"
 #include "models/arch_spec.h"
 #include "models/inference.h"
 #include "tests/models/model_cases.h"
-#include "train/upscaler.h"
 
 using namespace cgsr;
 using namespace cgsr::test;

@@ -1,10 +1,10 @@
-#include "train/upscaler.h"
+#include "eval/upscaler.h"
 
 #include <torch/torch.h>
 
+#include "eval/baselines/fsr1.h"
+#include "eval/baselines/interpolation.h"
 #include "models/inference.h"
-#include "train/baselines/fsr1.h"
-#include "train/baselines/interpolation.h"
 
 namespace cgsr {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
-#include "train/pattern_choice.h"
+#include "eval/pattern_choice.h"
 
 using namespace cgsr;
 

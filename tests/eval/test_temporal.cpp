@@ -3,7 +3,7 @@
 #include <torch/torch.h>
 
 #include "core/error.h"
-#include "train/temporal.h"
+#include "eval/temporal.h"
 
 using namespace cgsr;
 

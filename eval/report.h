@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
 
 namespace cgsr {
 
