@@ -198,14 +198,14 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   for (int frame : frames) {
     const Batch b = frame_batch(data, frame, result.scale, channels, depth);
     const auto raw = upscale_frame(b, frame);
-    const auto details = upscaler.frame_details();
+    const auto choice = upscaler.frame_choice();
     // Checked before clamping, which would turn infinite values into 0 and 1.
     if (!torch::isfinite(raw).all().item<bool>())
       throw Error(result.name + ": frame " + std::to_string(frame), "the upscaler produced NaN or infinite values");
     const auto sr = raw.clamp(0.0, 1.0);
     FrameScore score;
     score.frame = frame;
-    score.details = details;
+    score.choice = choice;
     score.psnr = psnr(sr, b.hr_color, quality).item<double>();
     score.ssim = ssim(sr, b.hr_color, quality).item<double>();
     if (std::isinf(score.psnr)) {
@@ -338,6 +338,25 @@ void put_edge_scores(nlohmann::ordered_json& j, std::optional<double> psnr_edge,
   j["edge_fraction"] = optional_value(edge_fraction);
 }
 
+// A frame's pattern choice in results files, under the key "details" it has always had there
+// (files written before it was typed read the same).
+nlohmann::ordered_json choice_json(const PatternChoice& c) {
+  return {{"previous_frame", c.previous_frame},
+          {"pattern", c.pattern},
+          {"channel_fraction", c.channel_fraction},
+          {"choose_ms", c.choose_ms}};
+}
+
+std::optional<PatternChoice> choice_from_json(const nlohmann::ordered_json& details) {
+  if (!details.is_object() || !details.contains("pattern")) return std::nullopt;
+  PatternChoice c;
+  c.pattern = details.at("pattern").get<int>();
+  c.channel_fraction = details.value("channel_fraction", 1.0);
+  c.previous_frame = details.value("previous_frame", false);
+  c.choose_ms = details.value("choose_ms", 0.0);
+  return c;
+}
+
 std::string csv_psnr(std::optional<double> value) {
   if (!value) return "";
   return std::isinf(*value) ? std::string("inf") : std::to_string(*value);
@@ -382,7 +401,7 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
     fj["temporal_error"] = f.temporal_error ? nlohmann::ordered_json(*f.temporal_error) : nullptr;
     fj["temporal_error_reference"] =
         f.temporal_error_reference ? nlohmann::ordered_json(*f.temporal_error_reference) : nullptr;
-    if (!f.details.is_null()) fj["details"] = f.details;
+    if (f.choice) fj["details"] = choice_json(*f.choice);
     j["frames"].push_back(fj);
   }
   return j;
@@ -437,7 +456,7 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
       if (!f.at("temporal_error").is_null()) s.temporal_error = f.at("temporal_error").get<double>();
       if (!f.at("temporal_error_reference").is_null())
         s.temporal_error_reference = f.at("temporal_error_reference").get<double>();
-      if (f.contains("details")) s.details = f["details"];
+      if (f.contains("details")) s.choice = choice_from_json(f["details"]);
       r.frames.push_back(s);
     }
     return r;

@@ -43,7 +43,7 @@ struct FrameScore {
   // compared pixels; none without an edge channel (or, for one side, without pixels there).
   std::optional<double> psnr_edge, psnr_rest, edge_fraction;
   std::optional<double> temporal_error, temporal_error_reference;  // none for the first frame
-  nlohmann::ordered_json details;  // Upscaler::frame_details() of this frame (null for most upscalers)
+  std::optional<PatternChoice> choice;  // Upscaler::frame_choice() of this frame (none for most upscalers)
 };
 
 struct EvalResult {

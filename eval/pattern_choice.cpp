@@ -11,11 +11,11 @@ namespace cgsr {
 std::optional<PatternChoices> pattern_choices(const EvalResult& result) {
   PatternChoices out;
   for (const auto& f : result.frames) {
-    if (!f.details.is_object() || !f.details.contains("pattern")) continue;
+    if (!f.choice) continue;
     FrameChoice c;
     c.frame = f.frame;
-    c.pattern = f.details["pattern"].get<int>();
-    c.channel_fraction = f.details.value("channel_fraction", 1.0);
+    c.pattern = f.choice->pattern;
+    c.channel_fraction = f.choice->channel_fraction;
     c.edge_fraction = f.edge_fraction;
     c.psnr = f.psnr;
     out.frames.push_back(c);

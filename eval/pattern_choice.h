@@ -1,7 +1,7 @@
 #pragma once
-// What a hybrid-pruned model chose per frame, read back from its evaluation: every frame an
-// upscaler that chooses a pattern per frame records `pattern` and `channel_fraction` in its
-// frame details (pruning/hybrid_upscaler.h). The report shows the choice next to the frame's
+// What a hybrid-pruned model chose per frame, read back from its evaluation: every frame of an
+// upscaler that chooses a pattern per frame (pruning/hybrid_upscaler.h) carries its
+// PatternChoice (upscaler.h, FrameScore::choice). The report shows the choice next to the frame's
 // geometry-edge density, how hard the rendering information says the frame is, as a table and
 // a plot; the verdict counts the patterns in use.
 //

@@ -19,6 +19,16 @@
 
 namespace cgsr {
 
+// What an upscaler that chooses a pattern per frame (a hybrid-pruned model:
+// pruning/hybrid_upscaler.h) chose for one frame. The evaluation records it per frame
+// (FrameScore::choice), the report and the verdict read it (pattern_choice.h).
+struct PatternChoice {
+  int pattern = 0;              // in the model's pattern pool; 0 is the widest (the static network)
+  double channel_fraction = 1;  // of the widest pattern's unit channels
+  bool previous_frame = false;  // the choice saw the previous frame's rendering information
+  double choose_ms = 0;         // time spent choosing
+};
+
 class Upscaler {
  public:
   virtual ~Upscaler() = default;
@@ -38,9 +48,9 @@ class Upscaler {
   // channels(), to previous_frame() before upscale() of the frame after it.
   virtual bool uses_previous_frame() const { return false; }
   virtual void previous_frame(const Batch& previous) {}
-  // What the last upscale() decided, for the per-frame record (e.g. the patterns a dynamically
-  // pruned network chose and the time spent choosing them); null when there is nothing to say.
-  virtual nlohmann::ordered_json frame_details() const { return nullptr; }
+  // The pattern the last upscale() chose, for the per-frame record; none for upscalers that
+  // choose nothing.
+  virtual std::optional<PatternChoice> frame_choice() const { return std::nullopt; }
 };
 
 // nearest, bilinear, bicubic, lanczos, fsr

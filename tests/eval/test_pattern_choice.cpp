@@ -16,7 +16,7 @@ FrameScore frame(int index, std::optional<int> pattern, double fraction, std::op
   f.frame = index;
   f.psnr = 30 + index;
   f.edge_fraction = edges;
-  if (pattern) f.details = {{"pattern", *pattern}, {"channel_fraction", fraction}};
+  if (pattern) f.choice = PatternChoice{*pattern, fraction};
   return f;
 }
 }  // namespace
@@ -59,4 +59,25 @@ TEST(PatternChoice, APlotNeedsEdgeDensities) {
   ASSERT_TRUE(choices);
   EXPECT_EQ(pattern_choice_markdown(r.name, *choices).find("!["), std::string::npos);
   EXPECT_THROW(write_pattern_choice_plot(std::filesystem::temp_directory_path() / "never.png", r.name, *choices), Error);
+}
+
+TEST(PatternChoice, TravelsThroughResultsFilesInItsOwnShape) {
+  EvalResult r;
+  r.name = "hybrid";
+  r.frames = {frame(3, 2, 0.5, 0.04), frame(4, std::nullopt, 1, 0.04)};
+  r.frames[0].choice->previous_frame = true;
+  r.frames[0].choice->choose_ms = 0.25;
+  const nlohmann::ordered_json j = to_json(r);
+  // The record results files have always had: the frame's "details", keys in this order.
+  EXPECT_EQ(j["frames"][0]["details"].dump(),
+            R"({"previous_frame":true,"pattern":2,"channel_fraction":0.5,"choose_ms":0.25})");
+  EXPECT_FALSE(j["frames"][1].contains("details"));
+  const EvalResult back = eval_result_from_json(j, "test");
+  ASSERT_TRUE(back.frames[0].choice);
+  EXPECT_EQ(back.frames[0].choice->pattern, 2);
+  EXPECT_DOUBLE_EQ(back.frames[0].choice->channel_fraction, 0.5);
+  EXPECT_TRUE(back.frames[0].choice->previous_frame);
+  EXPECT_DOUBLE_EQ(back.frames[0].choice->choose_ms, 0.25);
+  EXPECT_FALSE(back.frames[1].choice);
+  EXPECT_EQ(to_json(back).dump(), j.dump());
 }

@@ -134,7 +134,7 @@ EvalResult hybrid(double psnr, double mean_ms, const std::vector<int>& patterns)
   for (size_t i = 0; i < patterns.size(); ++i) {
     FrameScore f;
     f.frame = static_cast<int>(i);
-    f.details = {{"pattern", patterns[i]}, {"channel_fraction", 1.0 - 0.2 * patterns[i]}};
+    f.choice = PatternChoice{patterns[i], 1.0 - 0.2 * patterns[i]};
     r.frames.push_back(f);
   }
   return r;
