@@ -38,7 +38,7 @@ class Evaluator {
   virtual std::vector<int> block_drop_order() const { return {}; }
   // A generation's new candidates: reports each score as done(index, score), in index order
   // (the order the history records). By default one after another in this process; a
-  // distributed evaluator spreads them over processes (cli/distributed_search.h).
+  // distributed evaluator spreads them over processes (pipeline/distributed_search.h).
   virtual void evaluate_batch(const std::vector<ArchSpec>& specs,
                               const std::function<void(size_t index, const CandidateScore& score)>& done);
 };

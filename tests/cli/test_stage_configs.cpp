@@ -3,10 +3,10 @@
 // and the search stage's cache form (the shape its stage hash has always been made of).
 #include <gtest/gtest.h>
 
-#include "cli/commands/search.h"
-#include "cli/commands/train.h"
-#include "cli/distributed_run.h"
 #include "core/config.h"
+#include "pipeline/distributed_run.h"
+#include "pipeline/search_stage.h"
+#include "pipeline/train_stage.h"
 
 using namespace cgsr;
 using namespace cgsr::cli;

@@ -1,14 +1,14 @@
-// The search's real evaluator (cli/training_evaluator.h) on the tiny scene: fade, inheritance
+// The search's real evaluator (pipeline/training_evaluator.h) on the tiny scene: fade, inheritance
 // (of the blocks the parent's block importance spares) and training of a candidate give a finite score, and the parent is scored as the candidate
 // equal to it, so the pick rule compares networks that trained alike.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "cli/training_evaluator.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
 #include "models/importance/block_importance.h"
+#include "pipeline/training_evaluator.h"
 #include "search/search_space.h"
 #include "tests/support/tiny_data.h"
 

@@ -2,7 +2,7 @@
 // measurement is a failed check, never a silent pass.
 #include <gtest/gtest.h>
 
-#include "cli/pipeline_verdict.h"
+#include "pipeline/verdict.h"
 
 using namespace cgsr;
 using namespace cgsr::cli;

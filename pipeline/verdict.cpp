@@ -1,4 +1,4 @@
-#include "cli/pipeline_verdict.h"
+#include "pipeline/verdict.h"
 
 #include <spdlog/fmt/fmt.h>
 

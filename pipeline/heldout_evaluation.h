@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "cli/commands/render.h"
 #include "core/config.h"
 #include "eval/evaluation.h"
+#include "pipeline/render_stage.h"
 #include "render_data/dataset.h"
 
 namespace cgsr::cli {

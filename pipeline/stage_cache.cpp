@@ -1,4 +1,4 @@
-#include "cli/stage_cache.h"
+#include "pipeline/stage_cache.h"
 
 #include <cstdio>
 

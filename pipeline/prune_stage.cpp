@@ -1,4 +1,4 @@
-#include "cli/commands/prune.h"
+#include "pipeline/prune_stage.h"
 
 #include "core/yaml_json.h"
 #include "models/model_file.h"

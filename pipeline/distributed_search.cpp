@@ -1,4 +1,4 @@
-#include "cli/distributed_search.h"
+#include "pipeline/distributed_search.h"
 
 #include <spdlog/spdlog.h>
 

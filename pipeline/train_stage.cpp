@@ -1,8 +1,7 @@
-#include "cli/commands/train.h"
+#include "pipeline/train_stage.h"
 
 #include <spdlog/spdlog.h>
 
-#include "cli/distributed_run.h"
 #include "core/atomic_file.h"
 #include "core/hash.h"
 #include "core/yaml_json.h"
@@ -10,6 +9,7 @@
 #include "models/inherit.h"
 #include "models/model_file.h"
 #include "models/model_source.h"
+#include "pipeline/distributed_run.h"
 #include "render_data/dataset.h"
 
 namespace cgsr::cli {

@@ -1,4 +1,4 @@
-#include "cli/training_evaluator.h"
+#include "pipeline/training_evaluator.h"
 
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>

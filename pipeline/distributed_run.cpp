@@ -1,4 +1,4 @@
-#include "cli/distributed_run.h"
+#include "pipeline/distributed_run.h"
 
 #include <spdlog/spdlog.h>
 

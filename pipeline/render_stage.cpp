@@ -1,4 +1,4 @@
-#include "cli/commands/render.h"
+#include "pipeline/render_stage.h"
 
 #include <spdlog/spdlog.h>
 

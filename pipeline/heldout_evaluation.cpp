@@ -1,12 +1,12 @@
-#include "cli/heldout_evaluation.h"
+#include "pipeline/heldout_evaluation.h"
 
 #include <spdlog/spdlog.h>
 
 #include <set>
 
-#include "cli/commands/eval.h"
-#include "cli/commands/render.h"
 #include "core/error.h"
+#include "pipeline/eval_stage.h"
+#include "pipeline/render_stage.h"
 
 namespace cgsr::cli {
 namespace fs = std::filesystem;

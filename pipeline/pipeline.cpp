@@ -1,4 +1,4 @@
-#include "cli/commands/run.h"
+#include "pipeline/pipeline.h"
 
 #include <spdlog/spdlog.h>
 
@@ -8,15 +8,7 @@
 #include <functional>
 #include <map>
 
-#include "cli/commands/eval.h"
-#include "cli/commands/export.h"
-#include "cli/commands/prune.h"
-#include "cli/commands/render.h"
 #include "cli/commands/report.h"
-#include "cli/commands/search.h"
-#include "cli/distributed_run.h"
-#include "cli/commands/train.h"
-#include "cli/stage_cache.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/timing.h"
@@ -26,6 +18,14 @@
 #include "export/onnx_writer.h"
 #include "export/onnxruntime_runner.h"
 #include "models/model_file.h"
+#include "pipeline/distributed_run.h"
+#include "pipeline/eval_stage.h"
+#include "pipeline/export_stage.h"
+#include "pipeline/prune_stage.h"
+#include "pipeline/render_stage.h"
+#include "pipeline/search_stage.h"
+#include "pipeline/stage_cache.h"
+#include "pipeline/train_stage.h"
 #include "render_data/dataset.h"
 #include "render_data/patch_sampler.h"
 
@@ -129,7 +129,7 @@ struct StageOutcome {
   bool skipped = false;
 };
 
-// Runs the stages in their directories, skipping the finished ones (cli/stage_cache.h).
+// Runs the stages in their directories, skipping the finished ones (pipeline/stage_cache.h).
 class StageRunner {
  public:
   StageRunner(fs::path root, std::string from, int stages) : root_(std::move(root)), from_(std::move(from)), total_(stages) {}

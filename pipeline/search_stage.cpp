@@ -1,10 +1,8 @@
-#include "cli/commands/search.h"
+#include "pipeline/search_stage.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "cli/distributed_run.h"
-#include "cli/distributed_search.h"
 #include "core/atomic_file.h"
 #include "core/hash.h"
 #include "core/plot.h"
@@ -12,6 +10,8 @@
 #include "models/importance/block_importance.h"
 #include "models/inherit.h"
 #include "models/model_file.h"
+#include "pipeline/distributed_run.h"
+#include "pipeline/distributed_search.h"
 #include "render_data/dataset.h"
 
 namespace cgsr::cli {

@@ -11,13 +11,13 @@
 //   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
 //   eval     classic baselines, backbone, control and CG-enhanced on the test split  DIR/eval
 //   heldout  scenes not in the training data (when `heldout.scenes` names any): every model and
-//            the classic baselines on each (cli/heldout_evaluation.h)        DIR/heldout
+//            the classic baselines on each (pipeline/heldout_evaluation.h)        DIR/heldout
 //   report   every model timed again side by side; table, plot  DIR/report/report.md
-//            and the verdict (cli/pipeline_verdict.h)             DIR/verdict.txt
+//            and the verdict (pipeline/verdict.h)             DIR/verdict.txt
 //
 // Each stage's section is the config of the matching subcommand (cgsr train, cgsr search, ...)
 // without the paths, which the pipeline fills in. A stage directory records the hash of its
-// resolved config and of the stages it reads (cli/stage_cache.h): a rerun skips finished stages,
+// resolved config and of the stages it reads (pipeline/stage_cache.h): a rerun skips finished stages,
 // resumes an interrupted one, and reruns a stage whose config or inputs changed. `--from STAGE`
 // reruns that stage and every later one. DIR is --out, or runs/<name>.
 
@@ -27,9 +27,9 @@
 #include <vector>
 
 #include "cli/command.h"
-#include "cli/heldout_evaluation.h"
-#include "cli/pipeline_verdict.h"
 #include "export/export_format.h"
+#include "pipeline/heldout_evaluation.h"
+#include "pipeline/verdict.h"
 
 namespace cgsr::cli {
 

@@ -1,4 +1,4 @@
-#include "cli/commands/export.h"
+#include "pipeline/export_stage.h"
 
 #include <torch/torch.h>
 

@@ -1,4 +1,4 @@
-#include "cli/commands/eval.h"
+#include "pipeline/eval_stage.h"
 
 #include <spdlog/spdlog.h>
 

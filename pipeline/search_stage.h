@@ -6,8 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
-#include "cli/training_evaluator.h"
 #include "distributed/world.h"
+#include "pipeline/training_evaluator.h"
 #include "search/search_loop.h"
 
 namespace cgsr::cli {
