@@ -2,7 +2,7 @@
 // Parameters and multiply-accumulates (MACs) of a network for a given LR input size, per layer
 // and in total, counted on the inference graph (graph.h), so the geometry head never counts.
 //
-// Convention (DESIGN.md): a conv costs (weights) x (output pixels) = out * in/groups * k * k * H * W
+// Convention (docs/design.md): a conv costs (weights) x (output pixels) = out * in/groups * k * k * H * W
 // MACs; biases, activations, element-wise ops (additions, attention products, the RIT gate),
 // resizes, pooling and pixel shuffles cost nothing. Fixed 1x1 colour convs (EDSR's mean shift,
 // SRCNN's Y mode) count MACs but no parameters, as in the published counts. Parameters are the

@@ -1,5 +1,5 @@
 #pragma once
-// Activation memory layout inside training and inference. Interfaces stay NCHW (DESIGN.md);
+// Activation memory layout inside training and inference. Interfaces stay NCHW (docs/design.md);
 // inside, a network runs in the layout measured fastest for it on this machine. With Debian's
 // LibTorch (reference BLAS, oneDNN convolutions) channels-last is usually 2-4x faster, but the
 // choice is measured, not assumed, and NCHW stays available.

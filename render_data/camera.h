@@ -8,7 +8,7 @@
 // Pixel coordinates: x right, y down, (0,0) is the top-left corner of the image; pixel (i, j)
 // (row i, column j) covers [j, j+1) x [i, i+1) and is sampled at its centre (j + 0.5, i + 0.5).
 // NDC maps to the whole image at every resolution, so resolutions share one frustum and an HR
-// pixel centre (j + 0.5) lands on LR coordinate (j + 0.5) / s (DESIGN.md, align_corners=False).
+// pixel centre (j + 0.5) lands on LR coordinate (j + 0.5) / s (docs/design.md, align_corners=False).
 
 #include "render_data/scene.h"
 #include "render_data/vec_math.h"

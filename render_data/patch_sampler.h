@@ -15,7 +15,7 @@
 // Patches: a random frame of the split (of a multi-scene data set with scene weights: a scene
 // drawn by weight, then one of its frames; without: each scene in proportion to its frames in
 // the split), a random LR window, the HR window exactly `scale` times
-// it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), DESIGN.md). With
+// it (LR pixel (i, j) <-> HR pixels (s i .. s i + s - 1, s j .. s j + s - 1), docs/design.md). With
 // augment, each item gets one of the 8 flips/rotations, applied to every tensor; normals and
 // motion vectors are rotated/flipped as vectors (augment.h); with color_augment, its LR and HR
 // colour also get one colour permutation and gain. Batch k depends only on the seed

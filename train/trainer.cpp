@@ -158,7 +158,7 @@ Batch in_layout(Batch b, MemoryLayout layout) {
   return b;
 }
 
-// Hands the network back in NCHW however run() ends (DESIGN.md: NCHW in interfaces).
+// Hands the network back in NCHW however run() ends (docs/design.md: NCHW in interfaces).
 struct NchwOnExit {
   torch::nn::Module& module;
   ~NchwOnExit() { set_parameter_layout(module, MemoryLayout::Nchw); }

@@ -42,7 +42,7 @@ T clamp01(T v) {
   return std::min(std::max(v, T(0)), T(1));  // NaN stays NaN, as torch::clamp
 }
 
-// Input coordinate of an output pixel centre (DESIGN.md convention), computed like
+// Input coordinate of an output pixel centre (docs/design.md convention), computed like
 // (arange(n) + 0.5) / scale - 0.5 in T.
 template <typename T>
 T sample_coordinate(int64_t j, int scale) {

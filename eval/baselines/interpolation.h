@@ -1,5 +1,5 @@
 #pragma once
-// Classic interpolating upscalers. All use the pixel-centre convention of DESIGN.md: output
+// Classic interpolating upscalers. All use the pixel-centre convention of docs/design.md: output
 // pixel j samples the input at (j + 0.5) / scale - 0.5, with edge pixels replicated.
 
 #include <torch/types.h>

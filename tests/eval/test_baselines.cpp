@@ -116,7 +116,7 @@ TEST(Fsr1, ClampsSaturatedAndRejectsNonFiniteInput) {
 // another way (dense matrices, neighbourhood bounds, the two-pass composition) and to their
 // behaviour on extreme input.
 namespace {
-// Output j of an upscale by `scale` samples the input at this coordinate (DESIGN.md convention).
+// Output j of an upscale by `scale` samples the input at this coordinate (docs/design.md convention).
 double sample_coordinate(int64_t j, int scale) { return (j + 0.5) / scale - 0.5; }
 
 double lanczos3(double x) {
