@@ -6,13 +6,7 @@
 #include "core/hash.h"
 #include "core/runtime.h"
 
-namespace cgsr::cli {
-
-void add_distributed_flags(CLI::App& sub, std::vector<FlagAssignment>& flags) {
-  flag_to_key(sub, flags, "--world-size", "distributed.world_size", "processes in a distributed run");
-  flag_to_key(sub, flags, "--rank", "distributed.rank", "this process's rank (0 coordinates)");
-  flag_to_key(sub, flags, "--store", "distributed.store", "HOST:PORT of the store rank 0 hosts");
-}
+namespace cgsr {
 
 std::filesystem::path rank_run_dir(const distributed::DistributedOptions& options, const std::filesystem::path& out) {
   if (!options.enabled() || options.rank == 0) return out;
@@ -49,4 +43,4 @@ YAML::Node without_distribution(const YAML::Node& resolved) {
   return copy;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,22 +1,17 @@
 #pragma once
-// What `cgsr search` and `cgsr train` share when they run as several processes (distributed/):
-// the --world-size/--rank/--store flags, where a rank writes its run directory, and the check
-// that every rank was started on the same job.
+// What the search and train jobs share when they run as several processes (distributed/):
+// where a rank writes its run directory, and the check that every rank was started on the same
+// job.
 
-#include <CLI/CLI.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <vector>
 
-#include "cli/command.h"
 #include "distributed/world.h"
 
-namespace cgsr::cli {
-
-// --world-size N --rank R --store HOST:PORT, recorded as distributed.world_size/rank/store.
-void add_distributed_flags(CLI::App& sub, std::vector<FlagAssignment>& flags);
+namespace cgsr {
 
 // Rank 0 writes into --out itself; rank R > 0 into --out/rank<R> (its log and results), so N
 // processes on one machine can share one --out.
@@ -32,4 +27,4 @@ std::unique_ptr<distributed::World> join_run(const distributed::DistributedOptio
 // how many processes ran a stage does not change its result.
 YAML::Node without_distribution(const YAML::Node& resolved);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -4,7 +4,7 @@
 
 #include "models/arch_spec.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 namespace {
 // A task is the candidate's spec as YAML; its result the score as JSON (doubles round-trip).
@@ -29,4 +29,4 @@ void DistributedEvaluator::evaluate_batch(const std::vector<ArchSpec>& specs,
 
 int serve_candidates(distributed::WorkQueue& queue, Evaluator& local) { return queue.serve(candidate_runner(local)); }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -10,7 +10,7 @@
 #include "distributed/work_queue.h"
 #include "search/evaluator.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 class DistributedEvaluator : public Evaluator {
  public:
@@ -29,4 +29,4 @@ class DistributedEvaluator : public Evaluator {
 // Ranks > 0: trains the candidates rank 0 publishes until the search ends; returns how many.
 int serve_candidates(distributed::WorkQueue& queue, Evaluator& local);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

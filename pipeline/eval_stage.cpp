@@ -11,7 +11,7 @@
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 config::Schema<EvalCommandOptions> eval_schema() {
   config::Schema<EvalCommandOptions> s;
@@ -41,25 +41,6 @@ std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::str
   std::string display = name;
   if (display.empty()) display = model.provenance.extra.value("name", std::filesystem::path(entry).stem().string());
   return std::make_unique<NetworkUpscaler>(display, model.network);
-}
-
-void setup_eval(CLI::App& app) {
-  add_command<EvalCommandOptions>(
-      app, "eval", "Evaluate models and classic upscalers: PSNR, SSIM, temporal error, latency", eval_schema,
-      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        flag_to_key(sub, flags, "--data", "data", "data set directory");
-        list_to_key(sub, flags, "--model", "models",
-                    "model file or classic upscaler name (repeatable; 'classic' = all classic upscalers)", "--model");
-        flag_to_key(sub, flags, "--scene", "scene", "one scene of a multi-scene data set");
-        flag_to_key(sub, flags, "--split", "eval.split", "data set split");
-        flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");
-        flag_to_key(sub, flags, "--crop-border", "eval.crop_border", "HR pixels ignored at each border");
-        flag_to_key(sub, flags, "--save-frames", "eval.save_frames", "directory for upscaled frames");
-        flag_to_key(sub, flags, "--frames", "eval.frames", "frame index range A:B within the split");
-        flag_to_key(sub, flags, "--latency-runs", "eval.latency_runs", "timed runs for latency (0 = skip)");
-      },
-      [](const EvalCommandOptions& options, const YAML::Node&, RunDir* run_dir) { return run_eval(options, run_dir); },
-      /*always_run_dir=*/true);
 }
 
 namespace {
@@ -128,4 +109,4 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   return json;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,13 +1,18 @@
 #pragma once
-// `cgsr eval`: evaluates model files and classic upscalers on a data set split. Writes
-// results.json (one entry per upscaler), a per-frame CSV per upscaler and summary.csv.
+// The eval job: what `cgsr eval` runs, and the eval and heldout stages of `cgsr run`. Evaluates
+// model files and classic upscalers on a data set split. Writes results.json (one entry per
+// upscaler), a per-frame CSV per upscaler and summary.csv.
 
-#include <CLI/CLI.hpp>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
-#include "cli/command.h"
+#include "core/run_dir.h"
 #include "eval/evaluation.h"
+#include "pipeline/run_settings.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct EvalCommandOptions : RunSettings {
   std::string data;                 // data set directory (required)
@@ -19,10 +24,9 @@ struct EvalCommandOptions : RunSettings {
 };
 
 config::Schema<EvalCommandOptions> eval_schema();
-void setup_eval(CLI::App& app);
 nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir);
 
 // Builds the upscaler for one `models` entry: a model file or a classic upscaler name.
 std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,23 +1,23 @@
 #pragma once
-// `cgsr export`: writes a network as ONNX or TorchScript for other runtimes, optionally verified
+// The export job: what `cgsr export` runs, and the export stage of `cgsr run` (once per model
+// and format). Writes a network as ONNX or TorchScript for other runtimes, optionally verified
 // in them (export/verification.h).
 //
 //   cgsr export --model pan --scale 2 --format onnx --input 320x240 --out pan_x2.onnx --verify
 //   cgsr export --model runs/train/model.cgsr --format torchscript --out model.pt
 //
-// --out here names the exported file (the command writes no run directory). A hybrid-pruned model
-// file (pruning/hybrid_model.h) exports as a directory instead: --out DIR gets one file per
+// `out` names the exported file (the job writes no run directory). A hybrid-pruned model
+// file (pruning/hybrid_model.h) exports as a directory instead: `out` DIR gets one file per
 // pattern, selector.onnx, manifest.json and results.json (export/hybrid_export.h).
 
-#include <CLI/CLI.hpp>
-
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include "cli/command.h"
 #include "export/export_format.h"
 #include "export/onnx_writer.h"
+#include "pipeline/run_settings.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct ExportCommandOptions : RunSettings {
   std::string model;              // backbone name, spec YAML or model file
@@ -32,7 +32,6 @@ struct ExportCommandOptions : RunSettings {
 };
 
 config::Schema<ExportCommandOptions> export_schema();
-void setup_export(CLI::App& app);
 nlohmann::ordered_json run_export(const ExportCommandOptions& options);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

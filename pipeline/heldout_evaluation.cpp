@@ -8,7 +8,7 @@
 #include "pipeline/eval_stage.h"
 #include "pipeline/render_stage.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 namespace fs = std::filesystem;
 
 config::Schema<HeldoutOptions> heldout_schema() {
@@ -86,4 +86,4 @@ std::vector<std::string> heldout_scenes(const nlohmann::ordered_json& summary) {
   return scene_entries(summary, "scene");
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

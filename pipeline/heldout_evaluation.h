@@ -18,7 +18,7 @@
 #include "pipeline/render_stage.h"
 #include "render_data/dataset.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct HeldoutOptions {
   std::vector<std::string> scenes;  // cgsr render configs of scenes not in the training data
@@ -49,4 +49,4 @@ nlohmann::ordered_json run_heldout(const HeldoutOptions& options, const HeldoutJ
 std::vector<std::string> heldout_result_files(const nlohmann::ordered_json& summary);
 std::vector<std::string> heldout_scenes(const nlohmann::ordered_json& summary);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

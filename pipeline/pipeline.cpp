@@ -8,11 +8,11 @@
 #include <functional>
 #include <map>
 
-#include "cli/commands/report.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/timing.h"
 #include "core/yaml_json.h"
+#include "eval/report.h"
 #include "export/exporter.h"
 #include "export/hybrid_export.h"
 #include "export/onnx_writer.h"
@@ -31,7 +31,7 @@
 
 namespace fs = std::filesystem;
 
-namespace cgsr::cli {
+namespace cgsr {
 
 const std::vector<std::string>& pipeline_stages() {
   static const std::vector<std::string> stages = {"render", "train",  "enhance", "control", "search",
@@ -67,33 +67,6 @@ config::Schema<PipelineOptions> pipeline_schema() {
   });
   add_run_settings(s);
   return s;
-}
-
-namespace {
-// The default directory is stable (runs/<name>), so that a rerun finds its finished stages.
-fs::path run_root(const PipelineOptions& options) {
-  return globals().out.empty() ? fs::path("runs") / options.name : fs::path(globals().out);
-}
-}  // namespace
-
-void setup_run(CLI::App& app) {
-  add_command<PipelineOptions>(
-      app, "run", "The whole pipeline: render, train, CG-enhance, search, prune, export, evaluate, report",
-      pipeline_schema,
-      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        flag_to_key(sub, flags, "--from", "from", "rerun this stage and every later one (" + join(pipeline_stages()) + ")");
-        flag_to_key(sub, flags, "--data", "data", "use this data set instead of rendering the scene");
-      },
-      [](const PipelineOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
-        const fs::path dir = run_root(options);
-        std::unique_ptr<RunDir> own;
-        if (!run_dir) {
-          own = std::make_unique<RunDir>(dir);
-          own->write_config(resolved);
-        }
-        return run_pipeline(options, resolved, dir);
-      },
-      /*always_run_dir=*/false, /*place_run_dir=*/{}, check_pipeline);
 }
 
 namespace {
@@ -643,8 +616,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
   return Pipeline(options, resolved, root).run();
 }
 
-std::string check_pipeline(const PipelineOptions& options) {
-  return run_root(options).string() + ":\n" + Pipeline(options, YAML::Node(), run_root(options)).plan();
+std::string check_pipeline(const PipelineOptions& options, const fs::path& dir) {
+  return dir.string() + ":\n" + Pipeline(options, YAML::Node(), dir).plan();
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

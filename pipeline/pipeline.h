@@ -1,5 +1,6 @@
 #pragma once
-// `cgsr run --config configs/quickstart.yaml`: the whole CGSR pipeline in one command.
+// The whole CGSR pipeline, what `cgsr run --config configs/quickstart.yaml` runs: each stage a
+// job of this folder (<stage>_stage.h) in its own directory under DIR.
 //
 //   render   the scene (or use an existing data set)          DIR/data
 //   train    the plain backbone                               DIR/train
@@ -21,17 +22,18 @@
 // resumes an interrupted one, and reruns a stage whose config or inputs changed. `--from STAGE`
 // reruns that stage and every later one. DIR is --out, or runs/<name>.
 
-#include <CLI/CLI.hpp>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "cli/command.h"
+#include "core/config.h"
 #include "export/export_format.h"
 #include "pipeline/heldout_evaluation.h"
+#include "pipeline/run_settings.h"
 #include "pipeline/verdict.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct PipelineOptions : RunSettings {
   std::string name = "quickstart";  // default run directory runs/<name>
@@ -50,12 +52,12 @@ config::Schema<PipelineOptions> pipeline_schema();
 // The stage names, in order.
 const std::vector<std::string>& pipeline_stages();
 
-void setup_run(CLI::App& app);
+// Runs the stages in `dir`, skipping finished ones; returns the results (stages, their times).
 nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved,
                                     const std::filesystem::path& dir);
 // `cgsr run --check`: parses every stage's section and every scene config the run names (a
-// mistake is a cgsr::Error at its file, line and key) and returns what each stage will do;
-// runs and writes nothing.
-std::string check_pipeline(const PipelineOptions& options);
+// mistake is a cgsr::Error at its file, line and key) and returns what each stage will do in
+// `dir`; runs and writes nothing.
+std::string check_pipeline(const PipelineOptions& options, const std::filesystem::path& dir);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,16 +1,18 @@
 #pragma once
-// `cgsr prune`: hybrid pruning of a trained model for one scene (pruning/pruner.h). Writes
+// The prune job: what `cgsr prune` runs, and the prune stage of `cgsr run`. Hybrid pruning of a
+// trained model for one scene (pruning/pruner.h). Writes
 // pruned.cgsr (the statically pruned network with its dynamic pruning component), one
 // baseline<i>_<type>.cgsr per static baseline (magnitude pruning by default), pool.json,
 // fine-tuning checkpoints (for --resume) and results.json: `roles` names each model and its
 // file, and `evaluations` (input model, baselines, static, hybrid) feed `cgsr report`.
 
-#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
-#include "cli/command.h"
+#include "core/run_dir.h"
+#include "pipeline/run_settings.h"
 #include "pruning/pruner.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct PruneCommandOptions : RunSettings, PruneOptions {
   std::string model;    // trained model file (required)
@@ -19,7 +21,6 @@ struct PruneCommandOptions : RunSettings, PruneOptions {
 };
 
 config::Schema<PruneCommandOptions> prune_command_schema();
-void setup_prune(CLI::App& app);
 nlohmann::ordered_json run_prune(const PruneCommandOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

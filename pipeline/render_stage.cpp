@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "core/progress.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 namespace {
 config::Schema<SceneSetEntry> scene_set_entry_schema() {
@@ -51,29 +51,6 @@ config::Schema<RenderOptions> render_schema() {
   s.omit_when("scene", [](const RenderOptions& o) { return !o.scenes.empty(); });
   add_run_settings(s);
   return s;
-}
-
-
-void setup_render(CLI::App& app) {
-  add_command<RenderOptions>(
-      app, "render", "Render a scene config into a dataset (LR/HR colour, depth, normals, edges, motion)",
-      render_schema,
-      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        flag_to_key(sub, flags, "--frames", "frames", "frames to render");
-        flag_to_key(sub, flags, "--resolutions", "resolutions", "resolutions, e.g. [320x240,640x480]");
-        sub.add_option_function<std::vector<std::string>>(
-            "--scene",
-            [&flags](const std::vector<std::string>& configs) {
-              std::string list = "[";
-              for (size_t i = 0; i < configs.size(); ++i) list += (i ? ", " : "") + ("{config: '" + configs[i] + "'}");
-              flags.push_back({"scenes=" + list + "]", "--scene"});
-            },
-            "a scene config to render into the data set (repeatable: a scene set; config key 'scenes')");
-      },
-      [](const RenderOptions& options, const YAML::Node&, RunDir* run_dir) {
-        return run_render(options, run_dir->path());
-      },
-      /*always_run_dir=*/true);
 }
 
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options) {
@@ -172,4 +149,4 @@ nlohmann::ordered_json run_render(const RenderOptions& options, const std::files
   return j;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

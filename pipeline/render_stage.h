@@ -1,7 +1,8 @@
 #pragma once
-// `cgsr render --config configs/scenes/NAME.yaml --out DIR`: renders a scene at every requested
+// The render job: what `cgsr render --config configs/scenes/NAME.yaml --out DIR` runs, and the
+// render stage of `cgsr run` (and of its held-out scenes). Renders a scene at every requested
 // resolution into the cgsr dataset format (render_data/render_job.h, DATASET_FORMAT.md).
-// Re-running the same command on a partly rendered DIR resumes it.
+// Re-running it on a partly rendered DIR resumes it.
 //
 // Several scenes into one data set: `cgsr render --scene a.yaml --scene b.yaml --out DIR`, or a
 // scene-set config:
@@ -13,12 +14,15 @@
 // Each entry is a scene config as above, rendered as it says (with the command's seed) into
 // DIR/scenes/<name>; DIR/manifest.yaml lists the scenes (dataset_manifest.h).
 
-#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
-#include "cli/command.h"
+#include "pipeline/run_settings.h"
 #include "render_data/render_job.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 // A scene of a scene set.
 struct SceneSetEntry {
@@ -36,7 +40,6 @@ struct RenderOptions : RunSettings, RenderJobOptions {
 config::Schema<RenderOptions> render_schema();
 // The scene set's entries as render jobs, each parsed from its config file with its overrides.
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options);
-void setup_render(CLI::App& app);
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -14,7 +14,7 @@
 #include "pipeline/distributed_search.h"
 #include "render_data/dataset.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 config::Schema<SearchCommandOptions> search_command_schema() {
   config::Schema<SearchCommandOptions> s;
@@ -32,26 +32,6 @@ config::Schema<SearchCommandOptions> search_command_schema() {
             "train candidates on several processes or machines (docs/distributed.md)");
   add_run_settings(s);
   return s;
-}
-
-void setup_search(CLI::App& app) {
-  add_command<SearchCommandOptions>(
-      app, "search", "CG-guided evolutionary architecture search (CG-enhanced -> CG-optimized)",
-      search_command_schema,
-      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        flag_to_key(sub, flags, "--parent", "parent", "CG-enhanced model file");
-        flag_to_key(sub, flags, "--data", "data", "data set directory");
-        flag_to_key(sub, flags, "--strategy", "strategy", "evolution or random (with its default options)");
-        switch_to_key(sub, flags, "--resume", "resume", "continue an interrupted search in --out");
-        add_distributed_flags(sub, flags);
-      },
-      [](const SearchCommandOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
-        return run_search_command(options, resolved, *run_dir);
-      },
-      /*always_run_dir=*/true,
-      [](const SearchCommandOptions& options, const std::filesystem::path& out) {
-        return rank_run_dir(options.distributed, out);
-      });
 }
 
 YAML::Node search_config_cache_form(const YAML::Node& resolved) {
@@ -205,4 +185,4 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   return j;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,16 +1,18 @@
 #pragma once
-// `cgsr search`: the CG-guided architecture search. Starts from a CG-enhanced model file, evolves
-// smaller specs (search/search_loop.h), trains the pick longer and writes it as model.cgsr.
-// history.jsonl records every candidate and is the checkpoint of --resume.
+// The search job: what `cgsr search` runs, and the search stage of `cgsr run`. The CG-guided
+// architecture search starts from a CG-enhanced model file, evolves smaller specs
+// (search/search_loop.h), trains the pick longer and writes it as model.cgsr. history.jsonl
+// records every candidate and is the checkpoint of resume.
 
-#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
-#include "cli/command.h"
+#include "core/run_dir.h"
 #include "distributed/world.h"
+#include "pipeline/run_settings.h"
 #include "pipeline/training_evaluator.h"
 #include "search/search_loop.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct SearchCommandOptions : RunSettings {
   std::string parent;  // CG-enhanced model file (required)
@@ -30,8 +32,7 @@ config::Schema<SearchCommandOptions> search_command_schema();
 // {...}}`): the search stage of `cgsr run` hashes this form, so run directories made before stay
 // current when nothing but the shape changed.
 YAML::Node search_config_cache_form(const YAML::Node& resolved);
-void setup_search(CLI::App& app);
 nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
                                           RunDir& run_dir);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

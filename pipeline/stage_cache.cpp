@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 namespace {
 const char* kRecord = "stage.json";
 }
@@ -49,4 +49,4 @@ nlohmann::ordered_json stage_summary(const std::filesystem::path& dir) {
   }
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace cgsr::cli {
+namespace cgsr {
 
 // A stable hash (hex) of a config node and upstream stage hashes.
 std::string stage_hash(const YAML::Node& config, const std::vector<std::string>& upstream);
@@ -22,4 +22,4 @@ bool stage_is_current(const std::filesystem::path& dir, const std::string& hash)
 void mark_stage_done(const std::filesystem::path& dir, const std::string& hash, const nlohmann::ordered_json& summary);
 nlohmann::ordered_json stage_summary(const std::filesystem::path& dir);  // what mark_stage_done recorded
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -12,7 +12,7 @@
 #include "pipeline/distributed_run.h"
 #include "render_data/dataset.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 namespace {
 config::Schema<EnhanceOptions> enhance_schema(bool with_enabled) {
@@ -67,25 +67,6 @@ config::Schema<TrainOptions> enhance_stage_schema() {
     s.moved_block("enhance");  // older configs: `enhance: {enhance: {rit: ...}}`
     s.upgrade(drop_enabled);
   });
-}
-
-void setup_train(CLI::App& app) {
-  add_command<TrainOptions>(
-      app, "train", "Train a backbone or a CG-enhanced network", train_schema,
-      [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
-        flag_to_key(sub, flags, "--data", "data", "data set directory");
-        flag_to_key(sub, flags, "--model", "model", "backbone name, spec file or model file");
-        flag_to_key(sub, flags, "--steps", "schedule.steps", "optimizer steps");
-        switch_to_key(sub, flags, "--resume", "resume", "continue from the run directory's checkpoint");
-        add_distributed_flags(sub, flags);
-      },
-      [](const TrainOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
-        return run_train(options, resolved, *run_dir);
-      },
-      /*always_run_dir=*/true,
-      [](const TrainOptions& options, const std::filesystem::path& out) {
-        return rank_run_dir(options.distributed, out);
-      });
 }
 
 namespace {
@@ -166,4 +147,4 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
   return results;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

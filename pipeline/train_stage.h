@@ -1,17 +1,19 @@
 #pragma once
-// `cgsr train`: trains a plain backbone, or turns a trained backbone into a CG-enhanced network
-// (RIT + geometry head, inherited weights) and trains that. Writes model.cgsr (best validation
+// The train job: what `cgsr train` runs, and the train, enhance and control stages of `cgsr run`.
+// Trains a plain backbone, or turns a trained backbone into a CG-enhanced network (RIT +
+// geometry head, inherited weights) and trains that. Writes model.cgsr (best validation
 // weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
 
-#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
-#include "cli/command.h"
+#include "core/run_dir.h"
 #include "distributed/world.h"
 #include "models/arch_spec.h"
+#include "pipeline/run_settings.h"
 #include "train/losses.h"
 #include "train/trainer.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct EnhanceOptions {
   bool enabled = false;  // insert the RIT (and geometry head) into the model before training
@@ -36,7 +38,6 @@ config::Schema<TrainOptions> train_schema();
 // sit at its top level, as the stage always enhances. It parses into TrainOptions, which emits
 // (and is recorded) as a `cgsr train` config.
 config::Schema<TrainOptions> enhance_stage_schema();
-void setup_train(CLI::App& app);
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

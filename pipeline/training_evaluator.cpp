@@ -17,7 +17,7 @@
 #include "render_data/patch_sampler.h"
 #include "search/search_space.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 config::Schema<CandidateTraining> candidate_training_schema() {
   config::Schema<CandidateTraining> s;
@@ -113,4 +113,4 @@ CandidateScore TrainingEvaluator::evaluate(const ArchSpec& spec) {
   return score(child, outcome.best, seconds);
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -1,5 +1,5 @@
 #pragma once
-// The search's Evaluator, implemented with the trainer: this is where the search command wires
+// The search's Evaluator, implemented with the trainer: this is where the search job wires
 // training into the search (which itself never sees the trainer).
 //
 // A candidate is evaluated in three steps:
@@ -21,7 +21,7 @@
 #include "train/losses.h"
 #include "train/trainer.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct CandidateTraining {
   int fade_steps = 0;
@@ -52,4 +52,4 @@ class TrainingEvaluator : public Evaluator {
   int64_t lr_width_ = 0, lr_height_ = 0;  // validation frame size, for MACs and latency
 };
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

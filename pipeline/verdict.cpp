@@ -7,7 +7,7 @@
 
 #include "eval/pattern_choice.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 config::Schema<VerdictOptions> verdict_schema() {
   config::Schema<VerdictOptions> s;
@@ -178,4 +178,4 @@ nlohmann::ordered_json Verdict::to_json() const {
   return j;
 }
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

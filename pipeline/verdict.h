@@ -25,7 +25,7 @@
 #include "core/json_fields.h"
 #include "eval/evaluation.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct VerdictOptions {
   double max_search_loss_db = 0.3;  // PSNR the CG-optimized network may lose against its parent
@@ -78,4 +78,4 @@ struct Verdict {
 
 Verdict judge_pipeline(const PipelineResults& results, const VerdictOptions& options);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr

@@ -5,7 +5,6 @@
 #include "pipeline/verdict.h"
 
 using namespace cgsr;
-using namespace cgsr::cli;
 
 namespace {
 EvalResult result(const std::string& name, double psnr, int64_t params, int64_t macs, double latency_ms,

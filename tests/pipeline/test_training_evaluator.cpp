@@ -12,7 +12,7 @@
 #include "search/search_space.h"
 #include "tests/support/tiny_data.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 namespace {
 
 ArchSpec parent_spec() {
@@ -67,4 +67,4 @@ TEST(TrainingEvaluator, TheParentIsScoredAsTheCandidateEqualToIt) {
 }
 
 }  // namespace
-}  // namespace cgsr::cli
+}  // namespace cgsr

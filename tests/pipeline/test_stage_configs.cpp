@@ -9,7 +9,6 @@
 #include "pipeline/train_stage.h"
 
 using namespace cgsr;
-using namespace cgsr::cli;
 
 namespace {
 template <class T>
