@@ -7,13 +7,13 @@
 #include <cstdint>
 #include <string>
 
-#include "cli/commands/bench.h"
 #include "cli/commands/data_check.h"
 #include "cli/commands/report.h"
 #include "core/config.h"
 #include "core/error.h"
 #include "core/yaml_json.h"
 #include "eval/evaluation.h"
+#include "pipeline/bench.h"
 #include "pipeline/eval_stage.h"
 #include "pipeline/export_stage.h"
 #include "pipeline/pipeline.h"

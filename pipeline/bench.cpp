@@ -1,4 +1,4 @@
-#include "cli/commands/bench.h"
+#include "pipeline/bench.h"
 
 #include <torch/torch.h>
 
