@@ -8,6 +8,7 @@
 
 #include "cli/command.h"
 #include "cli/commands/ablate.h"
+#include "cli/commands/bench.h"
 #include "cli/commands/data_check.h"
 #include "cli/commands/eval.h"
 #include "cli/commands/export.h"
@@ -20,7 +21,6 @@
 #include "cli/commands/train.h"
 #include "core/error.h"
 #include "core/logging.h"
-#include "pipeline/bench.h"
 
 int main(int argc, char** argv) {
   using namespace cgsr::cli;

@@ -1,24 +1,24 @@
 #pragma once
-// `cgsr bench`: inference latency of a network: the median over repeated runs after warm-up,
-// min and max, and the effective throughput 2 x MACs / time.
+// The bench job, what `cgsr bench` runs: inference latency of a network: the median over
+// repeated runs after warm-up, min and max, and the effective throughput 2 x MACs / time.
 //
 // Each thing timed is a BenchTarget (a runtime + one inference on a prepared input); --model
 // adds the LibTorch target. Other runtimes (e.g. an exported ONNX file) add their own target
 // builder next to model_target() and run_bench() times them all the same way.
 
-#include <CLI/CLI.hpp>
-
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "cli/command.h"
+#include "core/config.h"
 #include "core/timing.h"
 #include "models/inference.h"
 #include "models/memory_layout.h"
 #include "models/model_source.h"
+#include "pipeline/run_settings.h"
 
-namespace cgsr::cli {
+namespace cgsr {
 
 struct BenchOptions : RunSettings {
   std::string model;              // backbone name, spec YAML or model file
@@ -49,7 +49,6 @@ struct BenchResult {
 };
 
 config::Schema<BenchOptions> bench_schema();
-void setup_bench(CLI::App& app);
 
 // --model, or the spec an exported ONNX file records when only --onnx is given (latency does not
 // depend on the weights).
@@ -63,4 +62,4 @@ nlohmann::ordered_json layer_profile(const BenchOptions& options);
 BenchResult time_target(const BenchTarget& target, int warmup, int runs);
 nlohmann::ordered_json run_bench(const BenchOptions& options);
 
-}  // namespace cgsr::cli
+}  // namespace cgsr
