@@ -1,4 +1,4 @@
-// Frame time of the classic upscalers (train/baselines) at 1080p output: one random frame
+// Frame time of the classic upscalers (eval/baselines) at 1080p output: one random frame
 // [1, 3, 540, 960] in [0,1] upscaled x2 to 1920x1080 on 2 threads (LibTorch intra-op and TBB).
 // Each benchmark runs 9 repetitions; the median line is the one to quote (ms per frame).
 //
@@ -8,8 +8,8 @@
 #include <torch/torch.h>
 
 #include "core/runtime.h"
-#include "train/baselines/fsr1.h"
-#include "train/baselines/interpolation.h"
+#include "eval/baselines/fsr1.h"
+#include "eval/baselines/interpolation.h"
 
 namespace {
 

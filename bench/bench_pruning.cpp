@@ -19,11 +19,11 @@
 
 #include "core/runtime.h"
 #include "core/timing.h"
+#include "eval/evaluation.h"
 #include "models/model_file.h"
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
 #include "render_data/patch_sampler.h"
-#include "train/evaluation.h"
 
 using namespace cgsr;
 

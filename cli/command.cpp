@@ -72,4 +72,10 @@ void switch_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, cons
       description + " (config key '" + key + "')");
 }
 
+void add_distributed_flags(CLI::App& sub, std::vector<FlagAssignment>& flags) {
+  flag_to_key(sub, flags, "--world-size", "distributed.world_size", "processes in a distributed run");
+  flag_to_key(sub, flags, "--rank", "distributed.rank", "this process's rank (0 coordinates)");
+  flag_to_key(sub, flags, "--store", "distributed.store", "HOST:PORT of the store rank 0 hosts");
+}
+
 }  // namespace cgsr::cli

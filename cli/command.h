@@ -13,6 +13,7 @@
 
 #include "core/config.h"
 #include "core/run_dir.h"
+#include "pipeline/run_settings.h"
 
 namespace cgsr::cli {
 
@@ -29,20 +30,6 @@ struct GlobalOptions {
 
 GlobalOptions& globals();
 void add_global_options(CLI::App& app);
-
-// Fields every command's options carry, so config.yaml alone reproduces a run.
-struct RunSettings {
-  int64_t seed = 0;
-  int threads = 0;
-};
-
-template <class T>
-void add_run_settings(config::Schema<T>& schema) {
-  schema.field("seed", static_cast<int64_t T::*>(&RunSettings::seed), "seed for every random number generator")
-      .at_least(0);
-  schema.field("threads", static_cast<int T::*>(&RunSettings::threads), "LibTorch and TBB threads (0 = all)")
-      .range(0, 1024);
-}
 
 // A command flag recorded as a config assignment, e.g. {"model=pan", "--model pan"}.
 struct FlagAssignment {
@@ -114,5 +101,9 @@ void list_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const 
 // Adds a boolean `--name` flag to `sub`, recorded as "key=true".
 void switch_to_key(CLI::App& sub, std::vector<FlagAssignment>& assignments, const std::string& flag,
                    const std::string& key, const std::string& description);
+
+// --world-size N --rank R --store HOST:PORT of a command that runs as several processes (cgsr
+// train, cgsr search: pipeline/distributed_run.h), recorded as distributed.world_size/rank/store.
+void add_distributed_flags(CLI::App& sub, std::vector<FlagAssignment>& flags);
 
 }  // namespace cgsr::cli

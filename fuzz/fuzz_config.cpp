@@ -7,20 +7,20 @@
 #include <cstdint>
 #include <string>
 
-#include "cli/commands/bench.h"
 #include "cli/commands/data_check.h"
-#include "cli/commands/eval.h"
-#include "cli/commands/export.h"
-#include "cli/commands/prune.h"
-#include "cli/commands/render.h"
 #include "cli/commands/report.h"
-#include "cli/commands/run.h"
-#include "cli/commands/search.h"
-#include "cli/commands/train.h"
 #include "core/config.h"
 #include "core/error.h"
 #include "core/yaml_json.h"
-#include "train/evaluation.h"
+#include "eval/evaluation.h"
+#include "pipeline/bench.h"
+#include "pipeline/eval_stage.h"
+#include "pipeline/export_stage.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/prune_stage.h"
+#include "pipeline/render_stage.h"
+#include "pipeline/search_stage.h"
+#include "pipeline/train_stage.h"
 
 namespace {
 using namespace cgsr;

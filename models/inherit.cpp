@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/text.h"
 #include "models/backbone_registry.h"
+#include "models/importance/channel_importance.h"
 
 namespace cgsr {
 

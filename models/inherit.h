@@ -2,12 +2,12 @@
 // Weight inheritance: builds a child spec's network from a trained parent (CGSR's warm start).
 //
 // Per layer group, the child keeps the parent channels of largest importance (L1 norm of the
-// weights producing them, SRNetworkImpl::channel_importance), in their original order, and copies
+// weights producing them, importance/channel_importance.h), in their original order, and copies
 // every tensor through the graph layouts: a channel removed from a residual stream is removed
 // from every layer writing into or reading from it, both operands of an attention product lose
 // the same channels, and a pixel-shuffle group keeps or drops all r*r sub-channels together.
 // Block i of the child inherits block i of the parent (a child may have fewer blocks), or the
-// parent block the caller names (block_importance.h: the search drops the least important).
+// parent block the caller names (importance/block_importance.h: the search drops the least important).
 //
 // Parts the parent lacks start fresh: a RIT (its fusion is zero, so the output equals the
 // parent's exactly) and the geometry head. The child's RIT may read a subset of the parent's

@@ -126,10 +126,6 @@ graph::Graph SRNetworkImpl::describe(bool training) const {
 
 torch::Tensor SRNetworkImpl::rit_gate() const { return has_rit() ? rit_->gate : torch::Tensor(); }
 
-std::map<std::string, torch::Tensor> SRNetworkImpl::channel_importance() const {
-  return cgsr::channel_importance(describe(false));
-}
-
 std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::Graph& graph,
                                                                   const torch::Tensor& lr_color,
                                                                   const torch::Tensor& info) {
@@ -139,28 +135,6 @@ std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::G
   if (info.defined() && inputs.size() == 1)
     throw Error("network inputs", "rendering information given to a network without a RIT block");
   return inputs;
-}
-
-std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph) {
-  std::map<std::string, torch::Tensor> out;
-  for (const auto& op : graph.ops) {
-    if (!op.trainable || !graph::op_traits(op.kind).has_tensors) continue;
-    const torch::Tensor per_position = graph::output_channel_magnitude(op);
-    int64_t offset = 0;
-    for (const auto& s : graph.values[op.output].layout) {
-      const int64_t span = s.channels * s.repeat;
-      if (s.prunable) {
-        const auto channel = per_position.slice(0, offset, offset + span).view({s.channels, s.repeat}).sum(1);
-        auto it = out.find(s.group);
-        if (it == out.end())
-          out.emplace(s.group, channel);
-        else
-          it->second = it->second + channel;
-      }
-      offset += span;
-    }
-  }
-  return out;
 }
 
 int64_t total_parameter_count(const SRNetworkImpl& net) {

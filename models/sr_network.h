@@ -8,8 +8,6 @@
 //   auto sr = net->forward(lr_color);                 // [N, 3, 2h, 2w]
 //   auto out = net->forward_train(lr_color, info);    // {image, geometry}
 //   loss += lambda_r * net->rit_gate().abs().sum();   // the paper's sum ||R_i||
-//   auto imp = net->channel_importance();             // group -> [width], differentiable
-//   loss += lambda_s * imp.at("block3_a").index_select(0, shrink).sum();   // sum ||S_k||
 //
 // `info` holds the spec's rendering channels (rit.channels, in render_channels.h order, depth in
 // rit.depth_encoding) at LR size for rit.source lr, at HR size for every other source; it may be
@@ -57,10 +55,6 @@ class SRNetworkImpl : public torch::nn::Module {
 
   // The RIT gate R [C] (a parameter; undefined without RIT).
   torch::Tensor rit_gate() const;
-  // Per prunable layer group of the inference network (backbone groups and "rit"): the L1 norm
-  // of the weights (and biases) producing each channel, differentiable. Pixel-shuffle groups sum
-  // their r*r sub-channels.
-  std::map<std::string, torch::Tensor> channel_importance() const;
 
   const ArchSpec& spec() const { return spec_; }
   std::vector<RenderChannel> input_channels() const { return spec_.input_channels(); }
@@ -86,9 +80,6 @@ TORCH_MODULE(SRNetwork);
 std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::Graph& graph,
                                                                   const torch::Tensor& lr_color,
                                                                   const torch::Tensor& info);
-
-// Importance of each channel of every prunable group produced in `graph` (see channel_importance).
-std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph);
 
 // Trainable parameters: all of them, and those of the inference network (no geometry head).
 int64_t total_parameter_count(const SRNetworkImpl& net);

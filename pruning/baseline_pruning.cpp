@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "core/text.h"
 #include "models/complexity.h"
-#include "pruning/importance.h"
+#include "models/importance/importance_methods.h"
 #include "pruning/pattern_pool.h"
 
 namespace cgsr {
@@ -61,7 +61,7 @@ Inheritance prune_to_rate(const SRNetworkImpl& net, const ChannelSelection& orde
 
 Inheritance magnitude_prune(const SRNetworkImpl& net, double keep_rate) {
   const auto units = find_units(net.describe(false));
-  return prune_to_rate(net, importance_order(units, {magnitude_importance(net, units)}), keep_rate);
+  return prune_to_rate(net, importance_order(units, {magnitude_importance(net, unit_groups(units))}), keep_rate);
 }
 
 double keep_rate_for_macs(const SRNetworkImpl& net, int64_t macs, int64_t lr_width, int64_t lr_height) {

@@ -1,8 +1,8 @@
 #pragma once
 // Static pruning baselines, the controls of hybrid pruning: every group of every pruning unit
 // keeps, at one keep rate, its kept_count(width, keep_rate) channels of highest importance under
-// one method of the registry (importance.h), ranked over the training frames. The geometry head
-// is dropped, as in static pruning. `magnitude` is the paper's MMP (Fig. 6(b); structured L1
+// one method of the registry (models/importance/importance_methods.h), ranked over the training
+// frames. The geometry head is dropped, as in static pruning. `magnitude` is the paper's MMP (Fig. 6(b); structured L1
 // pruning, Li et al. 2016). The hybrid model is compared with each at the same MACs (the mean
 // its frames execute), fine-tuned with the same number of steps.
 //
@@ -19,7 +19,7 @@
 namespace cgsr {
 
 struct BaselineOptions {
-  std::string type = "magnitude";  // an importance method (importance.h)
+  std::string type = "magnitude";  // an importance method (models/importance/importance_methods.h)
   double keep_rate = 0;            // 0: the rate whose MACs match the hybrid model's mean
 };
 config::Schema<BaselineOptions> baseline_schema();

@@ -56,7 +56,7 @@ int HybridUpscaler::choose(const Batch& batch) {
   previous_frame_ = -1;
   last_info_ = info;
   last_frame_ = frame;
-  details_ = {{"previous_frame", has_previous}};
+  chose_with_previous_ = has_previous;
   return choice;
 }
 
@@ -66,9 +66,7 @@ torch::Tensor HybridUpscaler::upscale(const Batch& batch) {
   const double choose_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   const auto out = patterns_->run(k, batch.lr_color, model_.network->info_input(batch));
   ++usage_[k];
-  details_["pattern"] = k;
-  details_["channel_fraction"] = model_.pool.channel_fraction(k);
-  details_["choose_ms"] = choose_ms;
+  choice_ = PatternChoice{k, model_.pool.channel_fraction(k), chose_with_previous_, choose_ms};
   return out;
 }
 

@@ -2,7 +2,7 @@
 // A hybrid-pruned model as an Upscaler: per frame, the dynamic pruning component scores the
 // pool's patterns from the current and previous frame's rendering information, and the chosen
 // pattern runs as its own narrow network on cgsr's fast path (pattern_networks.h). `cgsr eval`
-// runs it through the same evaluation as every other upscaler; frame_details() records the
+// runs it through the same evaluation as every other upscaler; frame_choice() records the
 // choice and the time spent choosing.
 //
 // The previous frame is the one given to previous_frame(), else the frame of the last
@@ -12,9 +12,9 @@
 #include <chrono>
 #include <memory>
 
+#include "eval/upscaler.h"
 #include "pruning/hybrid_model.h"
 #include "pruning/pattern_networks.h"
-#include "train/upscaler.h"
 
 namespace cgsr {
 
@@ -32,7 +32,7 @@ class HybridUpscaler : public Upscaler {
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   bool uses_previous_frame() const override { return true; }
   void previous_frame(const Batch& previous) override;
-  nlohmann::ordered_json frame_details() const override { return details_; }
+  std::optional<PatternChoice> frame_choice() const override { return choice_; }
 
   // The pattern chosen for a frame from its rendering information.
   int choose(const Batch& batch);
@@ -52,7 +52,8 @@ class HybridUpscaler : public Upscaler {
   int previous_frame_ = -1;       // its frame index (-1: none)
   int last_frame_ = -1;           // frame of the last upscale()
   torch::Tensor last_info_;
-  nlohmann::ordered_json details_;
+  bool chose_with_previous_ = false;     // the last choose() saw a previous frame
+  std::optional<PatternChoice> choice_;  // of the last upscale()
 };
 
 // Loads a hybrid-pruned model file as an upscaler; the display name defaults to the one recorded

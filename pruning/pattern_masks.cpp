@@ -3,14 +3,14 @@
 #include <torch/torch.h>
 
 #include "core/error.h"
-#include "pruning/activation_importance.h"
+#include "models/importance/activation_importance.h"
 
 namespace cgsr {
 
 PatternMasks::PatternMasks(const SRNetworkImpl& net, const PatternPool& pool)
     : graph_(net.describe(false)), pool_(pool) {
   masked_.assign(graph_.ops.size(), false);
-  for (size_t i : conv_input_producers(graph_, pool_.units)) masked_[i] = true;
+  for (size_t i : conv_input_producers(graph_, unit_groups(pool_.units))) masked_[i] = true;
   for (const auto& u : pool_.units)
     for (size_t g = 0; g < u.groups.size(); ++g) {
       auto p = torch::zeros({pool_.size(), u.widths[g]});

@@ -6,8 +6,8 @@
 // group a value in [0, 1]: the weighted sum of the patterns keeping it. Multiplying a layer's
 // weights by it along their input channels, W (.) m, equals scaling those channels by m before
 // the layer, so the masked network is run as the dense network with the values that feed
-// convolutions scaled per sample and channel (the values activation_importance.h reads). With a
-// one-hot choice this is exactly the narrow network of that pattern: a removed channel
+// convolutions scaled per sample and channel (the values models/importance/activation_importance.h
+// reads). With a one-hot choice this is exactly the narrow network of that pattern: a removed channel
 // contributes nothing to any convolution, and unit channels never reach a residual sum.
 //
 // The weights a pattern leaves out, W_P in Eq. 4 of the paper, are those attached to a removed

@@ -22,6 +22,7 @@
 #include <torch/types.h>
 
 #include "core/config.h"
+#include "models/importance/channel_importance.h"
 #include "models/inherit.h"
 #include "models/sr_network.h"
 #include "models/channel_selection.h"
@@ -55,9 +56,6 @@ PatternPool nested_pool(const std::vector<PrunableUnit>& units, const std::vecto
 // widest of them: what static pruning leaves when some patterns are never chosen.
 PatternPool keep_patterns(const PatternPool& pool, const std::vector<int>& kept,
                           const std::vector<PrunableUnit>& narrowed_units);
-
-// Per frame: layer group -> channel importance [width] (CPU float).
-using FrameImportance = std::map<std::string, torch::Tensor>;
 
 // Per group of `units`: channel indices by decreasing importance, each frame's importance
 // normalized to sum 1 first so that every frame counts alike (ties: the lower index first).

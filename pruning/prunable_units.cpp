@@ -20,6 +20,12 @@ int64_t PrunableUnit::width(const std::string& group) const {
 
 int64_t PrunableUnit::total_width() const { return std::accumulate(widths.begin(), widths.end(), int64_t{0}); }
 
+std::vector<std::string> unit_groups(const std::vector<PrunableUnit>& units) {
+  std::vector<std::string> groups;
+  for (const auto& u : units) groups.insert(groups.end(), u.groups.begin(), u.groups.end());
+  return groups;
+}
+
 int64_t kept_count(int64_t width, double keep_rate) {
   return std::clamp<int64_t>(std::llround(keep_rate * static_cast<double>(width)), 1, width);
 }

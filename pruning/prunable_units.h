@@ -32,6 +32,10 @@ struct PrunableUnit {
 
 std::vector<PrunableUnit> find_units(const graph::Graph& graph);
 
+// The groups of every unit, unit after unit: what the importance criteria score
+// (models/importance/).
+std::vector<std::string> unit_groups(const std::vector<PrunableUnit>& units);
+
 // Channels a pattern keeps of a group `width` wide at `keep_rate`: round(rate * width), at least 1.
 int64_t kept_count(int64_t width, double keep_rate);
 

@@ -6,10 +6,10 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "eval/pattern_choice.h"
 #include "pruning/hybrid_upscaler.h"
 #include "pruning/pattern_networks.h"
 #include "render_data/patch_sampler.h"
-#include "train/pattern_choice.h"
 
 namespace cgsr {
 
@@ -73,12 +73,12 @@ nlohmann::ordered_json against(const EvalResult& r, const EvalResult& base) {
 // Per frame of `frames`, the importance of every unit channel of `net` under `method`.
 std::vector<FrameImportance> importance_on(SRNetworkImpl& net, const Dataset& data, const std::vector<int>& frames,
                                            const std::string& method) {
-  const auto units = find_units(net.describe(false));
+  const auto groups = unit_groups(find_units(net.describe(false)));
   const ImportanceMethod& importance_method = importance_methods().get(method);
   std::vector<FrameImportance> out;
   Progress progress("importance (" + method + ")", static_cast<int64_t>(frames.size()));
   for (int f : frames) {
-    out.push_back(importance_method.score(net, frame_batch(data, f, net.spec().scale, net.input_channels(), net.depth_encoding()), units));
+    out.push_back(importance_method.score(net, frame_batch(data, f, net.spec().scale, net.input_channels(), net.depth_encoding()), groups));
     progress.advance();
   }
   progress.finish();

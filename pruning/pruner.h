@@ -26,21 +26,21 @@
 
 #include "core/config.h"
 #include "core/json_fields.h"
+#include "eval/evaluation.h"
+#include "models/importance/importance_methods.h"
 #include "models/model_file.h"
 #include "pruning/baseline_pruning.h"
 #include "pruning/dynamic_pruning.h"
 #include "pruning/dynamic_sampler.h"
-#include "pruning/importance.h"
 #include "pruning/pattern_pool.h"
 #include "pruning/static_pruning.h"
 #include "render_data/dataset.h"
-#include "train/evaluation.h"
 
 namespace cgsr {
 
 struct PruneOptions {
   std::string name;                 // display name of the input model (default: recorded name or file stem)
-  std::string importance = "taylor";  // a method of importance.h
+  std::string importance = "taylor";  // a method of models/importance/importance_methods.h
   int pool_frames = 0;              // training frames whose importance orders the channels (0 = all)
   PoolOptions pool;
   SamplerOptions sampler;

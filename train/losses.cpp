@@ -3,6 +3,7 @@
 #include <torch/torch.h>
 
 #include "core/error.h"
+#include "models/importance/channel_importance.h"
 
 namespace cgsr {
 
@@ -44,7 +45,7 @@ LossTerms cgsr_loss(const SRNetworkImpl& net, const TrainOutput& output, const B
     total = total + options.lambda_rit * rit;
   }
   if (options.lambda_shrink > 0 && !shrink.empty()) {
-    const auto importance = net.channel_importance();
+    const auto importance = channel_importance(net);
     auto sum = torch::zeros({}, output.image.options());
     for (const auto& [group, channels] : shrink) {
       const auto it = importance.find(group);

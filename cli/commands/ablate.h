@@ -2,13 +2,13 @@
 // `cgsr ablate`: does rendering information pay? From one trained plain network, trains the
 // control (the plain network trained on as long), every RIT source, the best source with each
 // channel left out and a small network with and without it, over several seeds
-// (train/ablation.h). Writes ablation.md, ablation.csv, ablation.png and results.json; each
+// (pipeline/ablation.h). Writes ablation.md, ablation.csv, ablation.png and results.json; each
 // (variant, seed) keeps its model and record under variants/, so a rerun resumes.
 
 #include <CLI/CLI.hpp>
 
 #include "cli/command.h"
-#include "train/ablation.h"
+#include "pipeline/ablation.h"
 
 namespace cgsr::cli {
 

@@ -1,28 +1,11 @@
 #pragma once
-// `cgsr eval`: evaluates model files and classic upscalers on a data set split. Writes
-// results.json (one entry per upscaler), a per-frame CSV per upscaler and summary.csv.
+// `cgsr eval`: evaluates model files and classic upscalers on a data set split (the eval job:
+// pipeline/eval_stage.h). Here: its flags.
 
 #include <CLI/CLI.hpp>
 
-#include "cli/command.h"
-#include "train/evaluation.h"
-
 namespace cgsr::cli {
 
-struct EvalCommandOptions : RunSettings {
-  std::string data;                 // data set directory (required)
-  std::string scene;                // one scene of a multi-scene data set; empty: every scene
-  std::vector<std::string> models;  // model files, classic upscaler names, or "classic" for all of them
-  std::vector<std::string> names;   // display names, in the order of `models` (optional)
-  int scale = 2;                    // scale of the classic upscalers (model files carry their own)
-  EvalOptions eval;
-};
-
-config::Schema<EvalCommandOptions> eval_schema();
 void setup_eval(CLI::App& app);
-nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir);
-
-// Builds the upscaler for one `models` entry: a model file or a classic upscaler name.
-std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale);
 
 }  // namespace cgsr::cli

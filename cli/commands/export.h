@@ -1,38 +1,12 @@
 #pragma once
-// `cgsr export`: writes a network as ONNX or TorchScript for other runtimes, optionally verified
-// in them (export/verification.h).
-//
-//   cgsr export --model pan --scale 2 --format onnx --input 320x240 --out pan_x2.onnx --verify
-//   cgsr export --model runs/train/model.cgsr --format torchscript --out model.pt
-//
-// --out here names the exported file (the command writes no run directory). A hybrid-pruned model
-// file (pruning/hybrid_model.h) exports as a directory instead: --out DIR gets one file per
-// pattern, selector.onnx, manifest.json and results.json (export/hybrid_export.h).
+// `cgsr export`: writes a network as ONNX or TorchScript, optionally verified in other runtimes
+// (the export job: pipeline/export_stage.h). Here: its flags; --out names the exported file
+// (the command writes no run directory).
 
 #include <CLI/CLI.hpp>
 
-#include <string>
-
-#include "cli/command.h"
-#include "export/export_format.h"
-#include "export/onnx_writer.h"
-
 namespace cgsr::cli {
 
-struct ExportCommandOptions : RunSettings {
-  std::string model;              // backbone name, spec YAML or model file
-  int scale = 0;                  // 0: the model file's scale, or 2 for a backbone name
-  ExportFormat format = ExportFormat::Onnx;
-  std::string input = "320x240";  // LR input size WxH (written into a fixed-size ONNX file)
-  bool dynamic_size = false;      // ONNX: symbolic batch, height and width
-  CubicResize cubic_resize = CubicResize::Conv;  // ONNX: bicubic resize as conv (portable) or native Resize
-  bool verify = false;            // run the file in the other runtimes and compare with our forward
-  double tolerance = 1e-4;        // max abs error allowed by --verify
-  std::string out;                // the file to write
-};
-
-config::Schema<ExportCommandOptions> export_schema();
 void setup_export(CLI::App& app);
-nlohmann::ordered_json run_export(const ExportCommandOptions& options);
 
 }  // namespace cgsr::cli

@@ -1,25 +1,11 @@
 #pragma once
-// `cgsr prune`: hybrid pruning of a trained model for one scene (pruning/pruner.h). Writes
-// pruned.cgsr (the statically pruned network with its dynamic pruning component), one
-// baseline<i>_<type>.cgsr per static baseline (magnitude pruning by default), pool.json,
-// fine-tuning checkpoints (for --resume) and results.json: `roles` names each model and its
-// file, and `evaluations` (input model, baselines, static, hybrid) feed `cgsr report`.
+// `cgsr prune`: hybrid pruning of a trained model for one scene (the prune job:
+// pipeline/prune_stage.h). Here: its flags.
 
 #include <CLI/CLI.hpp>
 
-#include "cli/command.h"
-#include "pruning/pruner.h"
-
 namespace cgsr::cli {
 
-struct PruneCommandOptions : RunSettings, PruneOptions {
-  std::string model;    // trained model file (required)
-  std::string data;     // data set directory (required)
-  bool resume = false;  // continue the fine-tuning from the run directory's checkpoints
-};
-
-config::Schema<PruneCommandOptions> prune_command_schema();
 void setup_prune(CLI::App& app);
-nlohmann::ordered_json run_prune(const PruneCommandOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 
 }  // namespace cgsr::cli

@@ -1,61 +1,12 @@
 #pragma once
-// `cgsr run --config configs/quickstart.yaml`: the whole CGSR pipeline in one command.
-//
-//   render   the scene (or use an existing data set)          DIR/data
-//   train    the plain backbone                               DIR/train
-//   enhance  backbone + RIT + geometry head (CG-enhanced)     DIR/enhance
-//   control  the backbone trained on with the enhance stage's schedule and seed: what the
-//            extra training alone gives, which the verdict compares CG-enhanced with   DIR/control
-//   search   CG-enhanced -> CG-optimized                      DIR/search
-//   prune    hybrid pruning + magnitude baseline              DIR/prune
-//   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
-//   eval     classic baselines, backbone, control and CG-enhanced on the test split  DIR/eval
-//   heldout  scenes not in the training data (when `heldout.scenes` names any): every model and
-//            the classic baselines on each (cli/heldout_evaluation.h)        DIR/heldout
-//   report   every model timed again side by side; table, plot  DIR/report/report.md
-//            and the verdict (cli/pipeline_verdict.h)             DIR/verdict.txt
-//
-// Each stage's section is the config of the matching subcommand (cgsr train, cgsr search, ...)
-// without the paths, which the pipeline fills in. A stage directory records the hash of its
-// resolved config and of the stages it reads (cli/stage_cache.h): a rerun skips finished stages,
-// resumes an interrupted one, and reruns a stage whose config or inputs changed. `--from STAGE`
-// reruns that stage and every later one. DIR is --out, or runs/<name>.
+// `cgsr run --config configs/quickstart.yaml`: the whole CGSR pipeline in one command
+// (pipeline/pipeline.h: its stages, their directories and caching). Here: its flags, and the run
+// directory, --out or runs/<name> (stable, so that a rerun finds its finished stages).
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-#include <string>
-#include <vector>
-
-#include "cli/command.h"
-#include "cli/heldout_evaluation.h"
-#include "cli/pipeline_verdict.h"
-#include "export/export_format.h"
 
 namespace cgsr::cli {
 
-struct PipelineOptions : RunSettings {
-  std::string name = "quickstart";  // default run directory runs/<name>
-  std::string scene;                // cgsr render config of the scene to render...
-  std::string data;                 // ...or an existing data set (then there is no render stage)
-  std::vector<std::string> baselines = {"bicubic"};  // classic upscalers in the report (bicubic is always added)
-  config::Block train, enhance, search, prune;      // the subcommands' configs, paths filled in
-  std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
-  config::Block eval;                // EvalOptions shared by the eval and prune stages
-  HeldoutOptions heldout;            // scenes never trained on, evaluated with every model
-  VerdictOptions verdict;
-  std::string from;                  // rerun this stage and every later one
-};
-config::Schema<PipelineOptions> pipeline_schema();
-
-// The stage names, in order.
-const std::vector<std::string>& pipeline_stages();
-
 void setup_run(CLI::App& app);
-nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::Node& resolved,
-                                    const std::filesystem::path& dir);
-// `cgsr run --check`: parses every stage's section and every scene config the run names (a
-// mistake is a cgsr::Error at its file, line and key) and returns what each stage will do;
-// runs and writes nothing.
-std::string check_pipeline(const PipelineOptions& options);
 
 }  // namespace cgsr::cli

@@ -1,37 +1,11 @@
 #pragma once
-// `cgsr search`: the CG-guided architecture search. Starts from a CG-enhanced model file, evolves
-// smaller specs (search/search_loop.h), trains the pick longer and writes it as model.cgsr.
-// history.jsonl records every candidate and is the checkpoint of --resume.
+// `cgsr search`: the CG-guided architecture search (the search job:
+// pipeline/search_stage.h). Here: its flags, and a distributed rank's own run directory.
 
 #include <CLI/CLI.hpp>
 
-#include "cli/command.h"
-#include "cli/training_evaluator.h"
-#include "distributed/world.h"
-#include "search/search_loop.h"
-
 namespace cgsr::cli {
 
-struct SearchCommandOptions : RunSettings {
-  std::string parent;  // CG-enhanced model file (required)
-  std::string data;    // data set directory (required)
-  SearchOptions search;  // its keys sit at the top level of the config
-  CandidateTraining candidate;
-  TrainSchedule final_schedule;  // training of the pick (paper: 30 epochs)
-  std::string name;              // display name of the result
-  bool resume = false;
-  distributed::DistributedOptions distributed;  // candidates spread over processes (docs/distributed.md)
-};
-
-config::Schema<SearchCommandOptions> search_command_schema();
-
-// A resolved `cgsr search` config in the shape it had before the search options moved to the top
-// level and each strategy got its own options block (`search: {strategy: evolution, operators:
-// {...}}`): the search stage of `cgsr run` hashes this form, so run directories made before stay
-// current when nothing but the shape changed.
-YAML::Node search_config_cache_form(const YAML::Node& resolved);
 void setup_search(CLI::App& app);
-nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
-                                          RunDir& run_dir);
 
 }  // namespace cgsr::cli

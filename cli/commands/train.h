@@ -1,42 +1,11 @@
 #pragma once
-// `cgsr train`: trains a plain backbone, or turns a trained backbone into a CG-enhanced network
-// (RIT + geometry head, inherited weights) and trains that. Writes model.cgsr (best validation
-// weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
+// `cgsr train`: trains a plain backbone or a CG-enhanced network (the train job:
+// pipeline/train_stage.h). Here: its flags, and a distributed rank's own run directory.
 
 #include <CLI/CLI.hpp>
 
-#include "cli/command.h"
-#include "distributed/world.h"
-#include "models/arch_spec.h"
-#include "train/losses.h"
-#include "train/trainer.h"
-
 namespace cgsr::cli {
 
-struct EnhanceOptions {
-  bool enabled = false;  // insert the RIT (and geometry head) into the model before training
-  RitSpec rit;
-  GeometrySpec geometry{true, 16};
-};
-
-struct TrainOptions : RunSettings {
-  std::string data;          // data set directory (required)
-  std::string model = "pan"; // backbone name, spec file, or model file to start from
-  int scale = 2;
-  std::string name;          // display name in reports (default: derived from the spec)
-  EnhanceOptions enhance;
-  TrainSchedule schedule;
-  LossOptions loss;
-  bool resume = false;       // continue from checkpoint.pt in --out
-  distributed::DistributedOptions distributed;  // data-parallel over processes (docs/distributed.md)
-};
-
-config::Schema<TrainOptions> train_schema();
-// The enhance stage of `cgsr run`: a training config whose enhance block's keys (rit, geometry)
-// sit at its top level, as the stage always enhances. It parses into TrainOptions, which emits
-// (and is recorded) as a `cgsr train` config.
-config::Schema<TrainOptions> enhance_stage_schema();
 void setup_train(CLI::App& app);
-nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 
 }  // namespace cgsr::cli

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
 #include "models/inherit.h"
 #include "tests/models/model_cases.h"
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "models/importance/channel_importance.h"
 #include "models/inherit.h"
 #include "models/sr_network.h"
 #include "tests/models/model_cases.h"
@@ -62,7 +63,7 @@ TEST(Rit, JointLossGradientsReachGateAndImportances) {
   const auto out = net->forward_train(color, info);
   ASSERT_TRUE(out.geometry.defined());
   EXPECT_EQ(out.geometry.sizes().vec(), (std::vector<int64_t>{1, 6, 12, 12}));
-  const auto importance = net->channel_importance();
+  const auto importance = channel_importance(*net);
   ASSERT_TRUE(importance.count("block0_a"));
   EXPECT_EQ(importance.at("block0_a").numel(), 20);
   EXPECT_EQ(importance.at("features").numel(), 40);
@@ -79,7 +80,7 @@ TEST(Rit, JointLossGradientsReachGateAndImportances) {
 
 TEST(Rit, ImportanceIsTheL1NormOfProducingWeights) {
   SRNetwork net(default_spec("edsr", 2));
-  const auto imp = net->channel_importance();
+  const auto imp = channel_importance(*net);
   const auto p = net->named_parameters();
   const auto& w = p["backbone.blocks.2.conv1.weight"];
   const auto& b = p["backbone.blocks.2.conv1.bias"];

@@ -2,10 +2,9 @@
 // measurement is a failed check, never a silent pass.
 #include <gtest/gtest.h>
 
-#include "cli/pipeline_verdict.h"
+#include "pipeline/verdict.h"
 
 using namespace cgsr;
-using namespace cgsr::cli;
 
 namespace {
 EvalResult result(const std::string& name, double psnr, int64_t params, int64_t macs, double latency_ms,
@@ -134,7 +133,7 @@ EvalResult hybrid(double psnr, double mean_ms, const std::vector<int>& patterns)
   for (size_t i = 0; i < patterns.size(); ++i) {
     FrameScore f;
     f.frame = static_cast<int>(i);
-    f.details = {{"pattern", patterns[i]}, {"channel_fraction", 1.0 - 0.2 * patterns[i]}};
+    f.choice = PatternChoice{patterns[i], 1.0 - 0.2 * patterns[i]};
     r.frames.push_back(f);
   }
   return r;

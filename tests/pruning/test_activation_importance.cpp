@@ -2,7 +2,7 @@
 // follows activation size, and the network is left as it was found.
 #include <gtest/gtest.h>
 
-#include "pruning/activation_importance.h"
+#include "models/importance/activation_importance.h"
 #include "tests/pruning/pruning_cases.h"
 
 using namespace cgsr;
@@ -33,8 +33,8 @@ TEST(ActivationImportance, UnreadAndSilentChannelsScoreZero) {
   const auto units = find_units(net->describe(false));
   const Batch b = batch_for(*net, 6, 5);
   net->train();
-  const auto taylor = frame_importance(*net, b, units, ActivationScore::Taylor);
-  const auto active = frame_importance(*net, b, units, ActivationScore::MeanAbsolute);
+  const auto taylor = frame_importance(*net, b, unit_groups(units), ActivationScore::Taylor);
+  const auto active = frame_importance(*net, b, unit_groups(units), ActivationScore::MeanAbsolute);
   EXPECT_TRUE(net->is_training());
   for (const auto& p : net->parameters()) EXPECT_FALSE(p.grad().defined());
   const auto t = taylor.at("block0_mid"), a = active.at("block0_mid");
@@ -53,7 +53,7 @@ TEST(ActivationImportance, ActivationMethodIsTheMeanMagnitude) {
   randomize(*net);
   const auto units = find_units(net->describe(false));
   const Batch b = batch_for(*net, 8, 8);
-  const auto active = frame_importance(*net, b, units, ActivationScore::MeanAbsolute);
+  const auto active = frame_importance(*net, b, unit_groups(units), ActivationScore::MeanAbsolute);
   // The value conv2 reads: the activated conv1 output; recompute it with the graph.
   const auto g = net->describe(false);
   torch::Tensor conv2_input;

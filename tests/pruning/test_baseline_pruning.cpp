@@ -7,8 +7,8 @@
 
 #include "core/error.h"
 #include "models/complexity.h"
+#include "models/importance/importance_methods.h"
 #include "pruning/baseline_pruning.h"
-#include "pruning/importance.h"
 #include "tests/pruning/pruning_cases.h"
 
 using namespace cgsr;
@@ -59,10 +59,10 @@ TEST(ImportanceMethods, OneRegistryScoresEveryUnitGroup) {
   b.lr_color = torch::rand({1, 3, 6, 5});
   b.hr_color = torch::rand({1, 3, 12, 10});
   b.frames = {0};
-  const auto reference = channel_importance(net->describe(false));
+  const auto reference = channel_importance(*net);
   for (const auto& name : importance_methods().names()) {
     SCOPED_TRACE(name);
-    const FrameImportance scores = importance_methods().get(name).score(*net, b, units);
+    const FrameImportance scores = importance_methods().get(name).score(*net, b, unit_groups(units));
     for (const auto& u : units)
       for (size_t g = 0; g < u.groups.size(); ++g) {
         ASSERT_TRUE(scores.count(u.groups[g]));

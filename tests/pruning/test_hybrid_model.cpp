@@ -70,15 +70,15 @@ TEST(HybridModel, RoundTripsAndLoadsAsAPlainModel) {
   for (int i = 0; i < 3; ++i) {
     const Batch f = frame(i);
     EXPECT_TRUE(torch::equal(a.upscale(f), b.upscale(f)));
-    EXPECT_EQ(a.frame_details()["pattern"], b.frame_details()["pattern"]);
+    EXPECT_EQ(a.frame_choice()->pattern, b.frame_choice()->pattern);
   }
   // The output is the chosen pattern run on the static network.
   const Batch f = frame(7);
   const auto out = b.upscale(f);
-  const int k = b.frame_details()["pattern"].get<int>();
+  const int k = b.frame_choice()->pattern;
   PatternNetworks patterns(*loaded.network, loaded.pool);
   EXPECT_TRUE(torch::allclose(out, patterns.run(k, f.lr_color, f.lr_info), 0, 1e-6));
-  EXPECT_GE(b.frame_details()["choose_ms"].get<double>(), 0.0);
+  EXPECT_GE(b.frame_choice()->choose_ms, 0.0);
 
   save_model(dir / "plain.cgsr", *h.network);
   EXPECT_THROW(load_hybrid_model(dir / "plain.cgsr"), Error);
@@ -90,14 +90,14 @@ TEST(HybridModel, UsesThePreviousFrame) {
   HybridUpscaler up("h", make_hybrid());
   const Batch f0 = frame(4), f1 = frame(5);
   up.upscale(f1);
-  EXPECT_FALSE(up.frame_details()["previous_frame"].get<bool>());
+  EXPECT_FALSE(up.frame_choice()->previous_frame);
   up.previous_frame(f0);
   up.upscale(f1);
-  EXPECT_TRUE(up.frame_details()["previous_frame"].get<bool>());
+  EXPECT_TRUE(up.frame_choice()->previous_frame);
   // Frame after frame, the last upscaled frame is the previous one.
   up.upscale(f0);
   up.upscale(f1);
-  EXPECT_TRUE(up.frame_details()["previous_frame"].get<bool>());
+  EXPECT_TRUE(up.frame_choice()->previous_frame);
   Batch two = frame(6);  // patterns are chosen per frame: one frame at a time
   two.lr_color = torch::rand({2, 3, 5, 6});
   two.lr_info = torch::rand({2, 3, 5, 6});

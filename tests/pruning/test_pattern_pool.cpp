@@ -66,7 +66,7 @@ TEST(PatternPool, ReorderedNetworkComputesTheSame) {
     EXPECT_LT(max_diff(ordered->forward(color, info), net->forward(color, info)), 1e-4);
     // The channels really moved: the first unit group's producing weights are permuted.
     const auto& g = units.front().groups.front();
-    const auto before = net->channel_importance().at(g), after = ordered->channel_importance().at(g);
+    const auto before = channel_importance(*net).at(g), after = channel_importance(*ordered).at(g);
     EXPECT_TRUE(torch::allclose(after, before.index_select(0, torch::tensor(order.at(g), torch::kLong))));
   }
 }

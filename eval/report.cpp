@@ -1,0 +1,220 @@
+#include "eval/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/pareto.h"
+#include "core/plot.h"
+#include "core/text.h"
+#include "eval/pattern_choice.h"
+
+namespace cgsr {
+namespace {
+struct Cells {
+  std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
+};
+
+std::string optional_fixed(std::optional<double> v, int digits, const std::string& none) {
+  return v ? fixed(*v, digits) : none;
+}
+
+Cells cells(const EvalResult& r) {
+  Cells c;
+  c.params = r.cost ? fixed(r.cost->params / 1000.0, 1) : "NA";
+  c.macs = r.cost ? fixed(r.cost->macs / 1e9, 2) : "NA";
+  c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
+  c.ort_latency = r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 2) : "-";
+  c.psnr = fixed(r.psnr, 2);
+  c.psnr_edge = optional_fixed(r.psnr_edge, 2, "-");
+  c.psnr_rest = optional_fixed(r.psnr_rest, 2, "-");
+  c.ssim = fixed(r.ssim, 4);
+  c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
+  return c;
+}
+}  // namespace
+
+std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
+  std::vector<ReportTable> tables;
+  for (const auto& r : results) {
+    auto it = std::find_if(tables.begin(), tables.end(),
+                           [&](const ReportTable& t) { return t.dataset == r.dataset && t.scale == r.scale; });
+    if (it == tables.end()) {
+      tables.push_back({r.dataset, r.scale, {}});
+      it = tables.end() - 1;
+    }
+    it->rows.push_back(r);
+  }
+  return tables;
+}
+
+std::vector<size_t> pareto_front(const ReportTable& table) {
+  std::vector<size_t> timed;  // rows without latency are on no front
+  std::vector<double> latency, psnr;
+  for (size_t i = 0; i < table.rows.size(); ++i)
+    if (table.rows[i].latency) {
+      timed.push_back(i);
+      latency.push_back(table.rows[i].latency->median_ms);
+      psnr.push_back(table.rows[i].psnr);
+    }
+  std::vector<size_t> front;
+  for (size_t k : cgsr::pareto_front(latency, psnr)) front.push_back(timed[k]);
+  return front;
+}
+
+std::string report_markdown(const ReportTable& table) {
+  std::ostringstream md;
+  const auto& first = table.rows.front();
+  md << "### " << table.dataset << " x" << table.scale << " (" << first.split << " split, " << first.frames.size()
+     << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
+  const bool ort = std::any_of(table.rows.begin(), table.rows.end(),
+                               [](const EvalResult& r) { return r.onnxruntime_latency.has_value(); });
+  // Edge and rest PSNR need the dataset's edge channel; rows from older results lack them.
+  const auto with_edges = std::find_if(table.rows.begin(), table.rows.end(),
+                                       [](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
+  const bool edges = with_edges != table.rows.end();
+  // A table evaluated for quality only (latency_runs 0, a held-out scene) has no latency column.
+  const bool timed = std::any_of(table.rows.begin(), table.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); });
+  md << "| Model | Params (k) | MACs (G) |" << (timed ? " Latency (ms) |" : "") << (ort ? " ONNX Runtime (ms) |" : "")
+     << " PSNR (dB) |" << (edges ? " Edge PSNR (dB) | Rest PSNR (dB) |" : "") << " SSIM | Temporal error (x1e-3) |\n";
+  md << "|---|---:|---:|" << (timed ? "---:|" : "") << (ort ? "---:|" : "") << "---:|" << (edges ? "---:|---:|" : "")
+     << "---:|---:|\n";
+  const auto front = pareto_front(table);
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    const auto& r = table.rows[i];
+    const auto c = cells(r);
+    const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+    md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | "
+       << (timed ? c.latency + " | " : "") << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
+       << (edges ? c.psnr_edge + " | " + c.psnr_rest + " | " : "") << c.ssim << " | " << c.temporal << " |\n";
+  }
+  if (first.temporal_error_reference)
+    md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
+       << "e-3. ";
+  if (timed)
+    md << "\n* on the Pareto front of PSNR against latency. MACs at the evaluated LR size; latency is the median "
+          "of repeated runs on this machine"
+       << (ort ? " (cgsr's own inference; ONNX Runtime: the exported file on the same input)" : "") << ".\n";
+  else
+    md << "\nMACs at the evaluated LR size.\n";
+  if (edges) {
+    md << "Edge PSNR: on the HR geometry-edge pixels grown by one pixel";
+    if (with_edges->edge_fraction) md << " (" << fixed(100.0 * *with_edges->edge_fraction, 1) << "% of the pixels)";
+    md << "; Rest PSNR: on the other pixels.\n";
+  }
+  return md.str();
+}
+
+std::string report_csv(const std::vector<ReportTable>& tables) {
+  std::ostringstream csv;
+  csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames,"
+         "onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n";
+  for (const auto& t : tables)
+    for (const auto& r : t.rows) {
+      csv << t.dataset << "," << t.scale << "," << r.name << "," << (r.cost ? std::to_string(r.cost->params) : "")
+          << "," << (r.cost ? std::to_string(r.cost->macs) : "") << ","
+          << (r.latency ? fixed(r.latency->median_ms, 4) : "") << "," << fixed(r.psnr, 4) << "," << fixed(r.ssim, 6)
+          << "," << (r.temporal_error ? fixed(*r.temporal_error, 6) : "") << ","
+          << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size() << ","
+          << (r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 4) : "") << ","
+          << optional_fixed(r.psnr_edge, 4, "") << "," << optional_fixed(r.psnr_rest, 4, "") << ","
+          << optional_fixed(r.edge_fraction, 6, "") << "\n";
+    }
+  return csv.str();
+}
+
+void write_report_plot(const std::filesystem::path& path, const ReportTable& table) {
+  ScatterPlot plot;
+  plot.title = table.dataset + " x" + std::to_string(table.scale) + ": PSNR against latency";
+  plot.x_label = "latency (ms, median, log scale)";
+  plot.y_label = "PSNR (dB)";
+  plot.log_x = true;
+  const auto front = pareto_front(table);
+  PlotSeries others{"upscaler", {40, 90, 180}, 5, false, {}}, best{"Pareto front", {220, 40, 40}, 6, true, {}};
+  for (size_t i = 0; i < table.rows.size(); ++i) {
+    const auto& r = table.rows[i];
+    const std::string label = std::to_string(i + 1);
+    plot.notes.push_back(label + ". " + r.name + " " + fixed(r.psnr, 2) + " dB" +
+                         (r.psnr_edge ? " (edges " + fixed(*r.psnr_edge, 2) + " dB)" : ""));
+    if (!r.latency) {
+      plot.horizontal_lines.emplace_back(r.psnr, r.name + " (no latency)");
+      continue;
+    }
+    const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+    (on_front ? best : others).points.push_back({r.latency->median_ms, r.psnr, label});
+  }
+  plot.series = {others, best};
+  write_scatter_plot(path, plot);
+}
+
+std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs) {
+  std::vector<EvalResult> out;
+  for (const auto& run : runs) {
+    std::filesystem::path file(run);
+    if (std::filesystem::is_directory(file)) file /= "results.json";
+    nlohmann::ordered_json j;
+    try {
+      j = nlohmann::ordered_json::parse(read_file(file));
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(file.string(), std::string("not valid JSON: ") + e.what());
+    }
+    if (!j.contains("evaluations") || !j["evaluations"].is_array())
+      throw Error(file.string(), "has no 'evaluations' (is it the results of cgsr eval or cgsr run?)");
+    for (size_t i = 0; i < j["evaluations"].size(); ++i)
+      out.push_back(eval_result_from_json(j["evaluations"][i], file.string() + ": evaluations[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
+                                    const std::vector<std::string>& heldout_scenes) {
+  const auto tables = group_results(evaluations);
+  std::string markdown;
+  nlohmann::ordered_json results;
+  results["tables"] = nlohmann::ordered_json::array();
+  for (const auto& t : tables) {
+    const bool heldout = std::find(heldout_scenes.begin(), heldout_scenes.end(), t.dataset) != heldout_scenes.end();
+    if (heldout)
+      markdown += "## Held-out scene: " + t.dataset +
+                  "\n\nNot in the training data: how the networks do on content they never saw (quality only; "
+                  "latency is the run's own table's).\n\n";
+    markdown += report_markdown(t) + "\n";
+    // A plot of PSNR against latency needs a latency (held-out scenes are evaluated for quality only).
+    std::string plot;
+    if (std::any_of(t.rows.begin(), t.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); })) {
+      plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale) + ".png";
+      write_report_plot(run_dir.file(plot), t);
+      markdown += "![PSNR against latency](" + plot + ")\n\n";
+    }
+    results["tables"].push_back(
+        {{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}, {"heldout", heldout}});
+    // Models that choose a pattern per frame: the choice next to each frame's edge density.
+    for (size_t i = 0; i < t.rows.size(); ++i) {
+      const auto choices = pattern_choices(t.rows[i]);
+      if (!choices) continue;
+      std::string choice_plot = "pattern_choice_" + t.dataset + "_x" + std::to_string(t.scale) + "_" +
+                                std::to_string(i + 1) + ".png";
+      const bool has_edges = std::any_of(choices->frames.begin(), choices->frames.end(),
+                                         [](const FrameChoice& c) { return c.edge_fraction.has_value(); });
+      if (has_edges)
+        write_pattern_choice_plot(run_dir.file(choice_plot), t.rows[i].name, *choices);
+      else
+        choice_plot.clear();
+      markdown += pattern_choice_markdown(t.rows[i].name, *choices, choice_plot);
+      results["pattern_choices"].push_back(
+          {{"model", t.rows[i].name}, {"patterns_used", choices->usage.size()}, {"plot", choice_plot}});
+    }
+  }
+  write_file_atomic(run_dir.file("report.md"), markdown);
+  write_file_atomic(run_dir.file("report.csv"), report_csv(tables));
+  std::printf("%s", markdown.c_str());
+  results["evaluations"] = nlohmann::ordered_json::array();
+  for (const auto& e : evaluations) results["evaluations"].push_back(to_json(e));
+  return results;
+}
+
+}  // namespace cgsr

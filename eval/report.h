@@ -1,0 +1,51 @@
+#pragma once
+// The error-against-run-time report: per scene and scale, one row per evaluated upscaler with
+// Params (k), MACs (G), latency (ms, median on this machine), PSNR (with PSNR on geometry edges
+// and on the rest when the results have them), SSIM and temporal error, as Markdown and CSV, plus a PNG plot of PSNR against latency with the Pareto front marked.
+// Every value comes from evaluation results; nothing is typed in.
+//
+// The report of run directories (`cgsr report`, the report stage of `cgsr run`): the
+// evaluations of their results.json files, collected, written as report.md, report.csv, a plot
+// per table, and a pattern-choice section per model that chooses a pattern per frame
+// (pattern_choice.h).
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/run_dir.h"
+#include "eval/evaluation.h"
+
+namespace cgsr {
+
+struct ReportTable {
+  std::string dataset;
+  int scale = 2;
+  std::vector<EvalResult> rows;  // in the order given
+};
+
+// Groups results by (dataset, scale), keeping their order within each group.
+std::vector<ReportTable> group_results(const std::vector<EvalResult>& results);
+
+std::string report_markdown(const ReportTable& table);
+std::string report_csv(const std::vector<ReportTable>& tables);
+
+// Indices of rows on the Pareto front: no other row is both faster and at least as good (PSNR).
+std::vector<size_t> pareto_front(const ReportTable& table);
+
+// Writes a PSNR-against-latency scatter plot (PNG); rows without latency are drawn as lines
+// across the plot at their PSNR.
+void write_report_plot(const std::filesystem::path& path, const ReportTable& table);
+
+// Every evaluation found in the given run directories / results files (results.json of
+// `cgsr eval`, `cgsr prune` or `cgsr report`), in order.
+std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs);
+
+// Writes report.md, report.csv and one plot per (scene, scale) into `run_dir` and prints the
+// tables; the results it returns carry the evaluations again, so a report can be reported on.
+// The tables of `heldout_scenes` (data set names) are headed as scenes not in the training data.
+nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
+                                    const std::vector<std::string>& heldout_scenes = {});
+
+}  // namespace cgsr

@@ -1,0 +1,32 @@
+#pragma once
+// The magnitude criterion: how much each channel of every prunable layer group matters by the
+// weights that produce it, the L1 norm of those weights (and biases), differentiable. A weight
+// statistic: it needs no data, and every caller computes the same ranking. Pixel-shuffle groups
+// sum their r*r sub-channels.
+//
+// Users: inheritance keeps a narrower child's most important channels (models/inherit.h), the
+// CGSR loss fades the channels a search candidate will drop (train/losses.h: sum ||S_k||), and
+// magnitude pruning ranks by it (importance_methods.h).
+//
+//   auto imp = channel_importance(*net);                                    // group -> [width]
+//   loss += lambda_s * imp.at("block3_a").index_select(0, shrink).sum();   // sum ||S_k||
+
+#include <torch/types.h>
+
+#include <map>
+#include <string>
+
+#include "models/graph.h"
+#include "models/sr_network.h"
+
+namespace cgsr {
+
+// Per layer group: channel importance [width] (the criteria of this folder all score this way).
+using FrameImportance = std::map<std::string, torch::Tensor>;
+
+// Importance of each channel of every prunable group produced in `graph`.
+std::map<std::string, torch::Tensor> channel_importance(const graph::Graph& graph);
+// The same for the network's inference graph (backbone groups and "rit"; no geometry head).
+std::map<std::string, torch::Tensor> channel_importance(const SRNetworkImpl& net);
+
+}  // namespace cgsr

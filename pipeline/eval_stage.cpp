@@ -1,0 +1,112 @@
+#include "pipeline/eval_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "core/atomic_file.h"
+#include "core/metrics.h"
+#include "eval/report.h"
+#include "models/model_file.h"
+#include "pruning/hybrid_upscaler.h"
+#include "render_data/dataset.h"
+
+namespace cgsr {
+
+config::Schema<EvalCommandOptions> eval_schema() {
+  config::Schema<EvalCommandOptions> s;
+  s.field("data", &EvalCommandOptions::data, "data set directory").required();
+  s.field("scene", &EvalCommandOptions::scene, "evaluate one scene of a multi-scene data set (default: all)");
+  s.omit_when("scene", [](const EvalCommandOptions& o) { return o.scene.empty(); });  // `cgsr run`'s eval hash as before
+  s.field("models", &EvalCommandOptions::models,
+          "model files and classic upscalers (" + join(classic_upscalers().names()) + ", or 'classic' for all)")
+      .check([](const auto& v) { return !v.empty(); }, "needs at least one model or upscaler");
+  s.field("names", &EvalCommandOptions::names, "display names, in the order of models");
+  s.field("scale", &EvalCommandOptions::scale, "scale of the classic upscalers").range(2, 4);
+  s.section("eval", &EvalCommandOptions::eval, eval_schema_fields(), "what and how to evaluate");
+  s.validate([](const EvalCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.names.empty() && o.names.size() != o.models.size())
+      at.child("names").fail(node["names"] ? node["names"] : node, "needs one name per model");
+  });
+  add_run_settings(s);
+  return s;
+}
+
+std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale) {
+  if (classic_upscalers().contains(entry)) return classic_upscalers().get(entry)(scale);
+  if (!std::filesystem::exists(entry))
+    throw Error(entry, "neither a model file nor a classic upscaler (" + join(classic_upscalers().names()) + ")");
+  Model model = load_model(entry);
+  if (is_hybrid_model(model.provenance)) return make_hybrid_upscaler(entry, name);  // per-frame dynamic pruning
+  std::string display = name;
+  if (display.empty()) display = model.provenance.extra.value("name", std::filesystem::path(entry).stem().string());
+  return std::make_unique<NetworkUpscaler>(display, model.network);
+}
+
+namespace {
+// The data set loading only the channels the upscalers read, plus motion vectors for the
+// temporal error and edges for the PSNR on geometry edges (evaluate() reads them at HR):
+// decoding a 1080p frame's other G-buffers would cost more than the metrics.
+Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upscaler>>& upscalers, bool temporal) {
+  std::vector<RenderChannel> needed;
+  for (const auto& u : upscalers)
+    for (auto c : u->channels()) needed.push_back(c);
+  if (temporal) needed.push_back(RenderChannel::Motion);
+  return open_for_channels(path, needed);
+}
+}  // namespace
+
+nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir) {
+  std::vector<std::pair<std::string, std::string>> entries;  // (model entry, display name)
+  for (size_t i = 0; i < options.models.size(); ++i) {
+    const std::string name = options.names.empty() ? "" : options.names[i];
+    if (options.models[i] == "classic") {
+      for (const auto& c : classic_upscalers().names()) entries.emplace_back(c, "");
+    } else {
+      entries.emplace_back(options.models[i], name);
+    }
+  }
+  std::vector<std::unique_ptr<Upscaler>> upscalers;
+  for (const auto& [entry, name] : entries) upscalers.push_back(make_upscaler(entry, name, options.scale));
+  Dataset data = open_for(options.data, upscalers, options.eval.temporal);
+  if (!options.scene.empty()) data = data.scene(options.scene);
+  std::vector<EvalResult> results;
+  nlohmann::ordered_json json;
+  json["data"] = data.info().root.string();
+  if (!options.scene.empty()) json["scene"] = options.scene;
+  json["evaluations"] = nlohmann::ordered_json::array();
+  // Each model's figures are written as soon as its quality is known: at 1080p the latency of the
+  // next models can take many minutes.
+  const auto write_results = [&](const EvalResult& r) {
+    if (!run_dir) return;
+    write_file_atomic(run_dir->file("frames_" + r.name + ".csv"), frames_csv(r));
+    std::vector<EvalResult> so_far = results;
+    so_far.push_back(r);
+    write_file_atomic(run_dir->file("summary.csv"), report_csv(group_results(so_far)));
+  };
+  for (auto& upscaler : upscalers) {
+    EvalResult r = evaluate(*upscaler, data, options.eval, write_results);
+    if (r.latency) spdlog::info("{}: latency {:.2f} ms (median of {})", r.name, r.latency->median_ms, r.latency->runs);
+    json["evaluations"].push_back(to_json(r));
+    if (data.scenes().size() > 1) {  // a multi-scene data set: quality per scene as well
+      auto& per_scene = json["evaluations"].back()["scenes"];
+      per_scene = nlohmann::ordered_json::array();
+      for (const SceneScore& s : scene_scores(r, data)) {
+        nlohmann::ordered_json j = {{"scene", s.scene}, {"frames", s.frames}};
+        put_psnr(j, "psnr", s.psnr);
+        j["ssim"] = s.ssim;
+        j["identical_frames"] = s.identical_frames;
+        per_scene.push_back(j);
+        spdlog::info("{} on scene '{}': PSNR {:.3f} dB, SSIM {:.4f} on {} frame(s)", r.name, s.scene, s.psnr, s.ssim,
+                     s.frames);
+      }
+    }
+    results.push_back(std::move(r));
+  }
+  const auto tables = group_results(results);
+  if (run_dir) write_file_atomic(run_dir->file("summary.csv"), report_csv(tables));
+  for (const auto& t : tables) std::printf("%s\n", report_markdown(t).c_str());
+  return json;
+}
+
+}  // namespace cgsr

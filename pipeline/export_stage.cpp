@@ -1,0 +1,165 @@
+#include "pipeline/export_stage.h"
+
+#include <torch/torch.h>
+
+#include <cstdio>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/runtime.h"
+#include "core/text.h"
+#include "export/exporter.h"
+#include "export/hybrid_export.h"
+#include "export/hybrid_verification.h"
+#include "export/onnx_writer.h"
+#include "export/verification.h"
+#include "models/arch_spec.h"
+#include "models/complexity.h"
+#include "models/model_source.h"
+#include "pruning/hybrid_model.h"
+
+namespace cgsr {
+
+config::Schema<ExportCommandOptions> export_schema() {
+  config::Schema<ExportCommandOptions> s;
+  s.field("model", &ExportCommandOptions::model, "backbone name, spec YAML file or model file to export").required();
+  s.field("scale", &ExportCommandOptions::scale, "scale for a backbone name (0: 2, or the file's)")
+      .check([](int v) { return v == 0 || (v >= 2 && v <= 4); }, "must be 0, 2, 3 or 4");
+  s.field("format", &ExportCommandOptions::format, "file format");
+  s.field("input", &ExportCommandOptions::input, "LR input size WxH");
+  s.field("dynamic_size", &ExportCommandOptions::dynamic_size, "ONNX: symbolic batch, height and width");
+  s.field("cubic_resize", &ExportCommandOptions::cubic_resize,
+          "ONNX: bicubic resize as a fixed conv (runs everywhere) or a native cubic Resize");
+  s.field("verify", &ExportCommandOptions::verify, "verify the file in other runtimes against our forward pass");
+  s.field("tolerance", &ExportCommandOptions::tolerance, "max abs error allowed by verify").range(0, 1);
+  s.field("out", &ExportCommandOptions::out, "the file to write (a directory for a hybrid-pruned model)").required();
+  s.validate([](const ExportCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    parse_size(o.input, "input");
+    if (o.dynamic_size && o.format != ExportFormat::Onnx)
+      at.child("dynamic_size").fail(node, "only ONNX files have a fixed size; a TorchScript file takes any size");
+  });
+  add_run_settings(s);
+  return s;
+}
+
+namespace {
+
+// Prints the verification table and turns failures into errors naming `what`.
+void report_verification(const VerifyReport& report, double tolerance, const std::string& what) {
+  std::printf("\n%s", report.table().c_str());
+  std::printf("verification: %d passed, %d failed, %d skipped (tolerance %g)\n", report.passed(), report.failed(),
+              report.skipped(), tolerance);
+  if (report.failed() > 0)
+    throw Error(what, "verification failed: " + std::to_string(report.failed()) + " of " +
+                          std::to_string(report.checks.size()) +
+                          " checks did not run or did not match our forward pass",
+                ErrorKind::Internal);
+  if (!report.ok()) throw Error(what, "verification could not run: every runtime was skipped (see above)");
+}
+
+// A hybrid-pruned model: a directory of pattern files, the selector and the manifest.
+nlohmann::ordered_json run_hybrid_export(const ExportCommandOptions& options, const ExportOptions& o) {
+  const HybridModel model = load_hybrid_model(options.model);
+  const HybridExport exported = export_hybrid(model, options.out, o);
+  nlohmann::ordered_json results;
+  results["model"] = exported.manifest.at("model");
+  results["hybrid"] = true;
+  results["dir"] = exported.dir.string();
+  results["manifest"] = exported.manifest_file.string();
+  results["format"] = enum_name(o.format);
+  std::printf("%s: hybrid-pruned %s, %d patterns (%s) + selector\n", exported.dir.string().c_str(),
+              exported.manifest.at("model").get<std::string>().c_str(), static_cast<int>(exported.patterns.size()),
+              enum_name(o.format).c_str());
+  std::printf("  %s\n", signature_string(exported.patterns.front().signature, o.width, o.height).c_str());
+  std::printf("  %-16s %8s %10s %10s %10s\n", "file", "channels", "MACs", "KiB", "latency");
+  auto files = nlohmann::ordered_json::array();
+  const auto& entries = exported.manifest.at("patterns");
+  for (size_t k = 0; k < exported.patterns.size(); ++k) {
+    const auto& e = entries.at(k);
+    char latency[32] = "-";
+    if (!e.at("latency_ms").is_null()) std::snprintf(latency, sizeof latency, "%.2f ms", e.at("latency_ms").get<double>());
+    std::printf("  %-16s %7.0f%% %10s %10.1f %10s\n", e.at("file").get<std::string>().c_str(),
+                100.0 * e.at("channel_fraction").get<double>(), format_count(e.at("macs").get<double>()).c_str(),
+                static_cast<double>(exported.patterns[k].bytes) / 1024.0, latency);
+    files.push_back({{"file", exported.patterns[k].file.string()}, {"bytes", exported.patterns[k].bytes}});
+  }
+  const auto selector_bytes = std::filesystem::file_size(exported.selector_file);
+  std::printf("  %-16s %8s %10s %10.1f\n", kSelectorFile, "-",
+              format_count(exported.manifest.at("selector").at("macs").get<double>()).c_str(),
+              static_cast<double>(selector_bytes) / 1024.0);
+  files.push_back({{"file", exported.selector_file.string()}, {"bytes", selector_bytes}});
+  results["files"] = files;
+  const OnnxModelInfo selector = inspect_onnx_file(exported.selector_file);
+  std::vector<std::string> ops;
+  for (const auto& [type, count] : selector.op_counts) ops.push_back(type + " " + std::to_string(count));
+  std::printf("  selector: opset %lld, ONNX checker ok; %s\n", static_cast<long long>(selector.opset), join(ops).c_str());
+  std::printf("  manifest: %s\n", exported.manifest_file.string().c_str());
+  // results.json sits beside the files (also when verification fails, so the failure is on record).
+  const auto results_file = exported.dir / "results.json";
+  if (!options.verify) {
+    write_file_atomic(results_file, results.dump(2) + "\n");
+    return results;
+  }
+  VerifyOptions v;
+  v.tolerance = options.tolerance;
+  const uint64_t seed = make_rng("export-verify")();
+  const VerifyReport report = verify_hybrid_export(model, exported, v, seed);
+  results["verification"] = report.to_json();
+  write_file_atomic(results_file, results.dump(2) + "\n");
+  report_verification(report, options.tolerance, exported.dir.string());
+  return results;
+}
+
+}  // namespace
+
+nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
+  const auto [w, h] = parse_size(options.input, "--input");
+  ExportOptions o;
+  o.format = options.format;
+  o.width = w;
+  o.height = h;
+  o.dynamic_size = options.dynamic_size;
+  o.cubic = options.cubic_resize;
+  ModelSource source = resolve_model(options.model, options.scale);
+  if (source.provenance && is_hybrid_model(*source.provenance)) return run_hybrid_export(options, o);
+  SRNetwork net = source.network;
+  net->eval();
+  const ExportedModel exported = export_network(*net, options.out, o);
+
+  nlohmann::ordered_json results;
+  results["model"] = spec_summary(source.spec);
+  results["file"] = exported.file.string();
+  results["format"] = enum_name(exported.format);
+  results["bytes"] = exported.bytes;
+  results["dynamic_size"] = exported.dynamic_size;
+  results["signature"] = exported.dynamic_size ? signature_string(exported.signature, w, h) + " (any size)"
+                                               : signature_string(exported.signature, w, h);
+  std::printf("%s: %s, %s\n", exported.file.string().c_str(), results["model"].get<std::string>().c_str(),
+              enum_name(exported.format).c_str());
+  std::printf("  %s\n", results["signature"].get<std::string>().c_str());
+  if (exported.format == ExportFormat::Onnx) {
+    const OnnxModelInfo info = inspect_onnx_file(exported.file);
+    std::vector<std::string> ops;
+    for (const auto& [type, count] : info.op_counts) {
+      ops.push_back(type + " " + std::to_string(count));
+      results["onnx_ops"][type] = count;
+    }
+    results["opset"] = info.opset;
+    std::printf("  opset %lld, ONNX checker ok; %s\n", static_cast<long long>(info.opset), join(ops).c_str());
+  }
+  std::printf("  %.1f KiB\n", static_cast<double>(exported.bytes) / 1024.0);
+  if (!options.verify) return results;
+
+  // Random frames at the export size, and for size-free files also at a second, odd size.
+  std::vector<std::pair<int64_t, int64_t>> sizes = {{w, h}};
+  if (exported.dynamic_size) sizes.emplace_back(w / 2 + 3, h / 2 + 1);
+  VerifyOptions v;
+  v.tolerance = options.tolerance;
+  const uint64_t seed = make_rng("export-verify")();
+  const VerifyReport report = verify_exports({make_verify_case(*net, exported, sizes, seed)}, v);
+  results["verification"] = report.to_json();
+  report_verification(report, options.tolerance, exported.file.string());
+  return results;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,43 @@
+#pragma once
+// The train job: what `cgsr train` runs, and the train, enhance and control stages of `cgsr run`.
+// Trains a plain backbone, or turns a trained backbone into a CG-enhanced network (RIT +
+// geometry head, inherited weights) and trains that. Writes model.cgsr (best validation
+// weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
+
+#include <nlohmann/json.hpp>
+
+#include "core/run_dir.h"
+#include "distributed/world.h"
+#include "models/arch_spec.h"
+#include "pipeline/run_settings.h"
+#include "train/losses.h"
+#include "train/trainer.h"
+
+namespace cgsr {
+
+struct EnhanceOptions {
+  bool enabled = false;  // insert the RIT (and geometry head) into the model before training
+  RitSpec rit;
+  GeometrySpec geometry{true, 16};
+};
+
+struct TrainOptions : RunSettings {
+  std::string data;          // data set directory (required)
+  std::string model = "pan"; // backbone name, spec file, or model file to start from
+  int scale = 2;
+  std::string name;          // display name in reports (default: derived from the spec)
+  EnhanceOptions enhance;
+  TrainSchedule schedule;
+  LossOptions loss;
+  bool resume = false;       // continue from checkpoint.pt in --out
+  distributed::DistributedOptions distributed;  // data-parallel over processes (docs/distributed.md)
+};
+
+config::Schema<TrainOptions> train_schema();
+// The enhance stage of `cgsr run`: a training config whose enhance block's keys (rit, geometry)
+// sit at its top level, as the stage always enhances. It parses into TrainOptions, which emits
+// (and is recorded) as a `cgsr train` config.
+config::Schema<TrainOptions> enhance_stage_schema();
+nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
+
+}  // namespace cgsr

@@ -1,0 +1,181 @@
+#include "pipeline/verdict.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <map>
+#include <optional>
+
+#include "eval/pattern_choice.h"
+
+namespace cgsr {
+
+config::Schema<VerdictOptions> verdict_schema() {
+  config::Schema<VerdictOptions> s;
+  s.field("max_search_loss_db", &VerdictOptions::max_search_loss_db,
+          "test PSNR the CG-optimized network may lose against the CG-enhanced one")
+      .at_least(0);
+  s.field("max_prune_loss_db", &VerdictOptions::max_prune_loss_db,
+          "test PSNR the pruned network may lose against the CG-optimized one")
+      .at_least(0);
+  s.field("min_enhance_gain_db", &VerdictOptions::min_enhance_gain_db,
+          "test PSNR the CG-enhanced network must gain over the plain backbone trained as long (may be negative)");
+  s.field("min_enhance_edge_gain_db", &VerdictOptions::min_enhance_edge_gain_db,
+          "the same gain on geometry-edge pixels (the HR edge map dilated by 1 pixel)");
+  s.field("max_hybrid_latency_ratio", &VerdictOptions::max_hybrid_latency_ratio,
+          "mean latency per frame of the hybrid model against its static network's")
+      .at_least(0);
+  s.field("max_hybrid_loss_db", &VerdictOptions::max_hybrid_loss_db,
+          "test PSNR the hybrid model may lose against its static network")
+      .at_least(0);
+  s.field("min_hybrid_gain_over_magnitude_db", &VerdictOptions::min_hybrid_gain_over_magnitude_db,
+          "test PSNR the hybrid model must gain over magnitude pruning at its mean MACs (may be negative)");
+  s.field("min_patterns_used", &VerdictOptions::min_patterns_used, "distinct patterns chosen on the test frames")
+      .at_least(0);
+  s.field("fail_run", &VerdictOptions::fail_run, "exit with an error when a check fails");
+  return s;
+}
+
+std::vector<const EvalResult*> PipelineResults::networks() const {
+  std::vector<const EvalResult*> out;
+  for (const EvalResult* r : {backbone, control, cg_enhanced, cg_optimized, pruned})
+    if (r) out.push_back(r);
+  return out;
+}
+
+namespace {
+
+// "a cuts X of b": strictly smaller, with the ratio in the detail.
+void check_cut(Verdict& v, const std::string& stage, const std::string& what, const EvalResult& before,
+               const EvalResult& after, double before_value, double after_value, const char* unit) {
+  const bool passed = after_value < before_value;
+  v.checks.push_back({stage + " cuts " + what, passed,
+                      fmt::format("{}: {:.4g} -> {}: {:.4g} {} ({:.0f}% of it)", before.name, before_value, after.name,
+                                  after_value, unit, before_value > 0 ? 100.0 * after_value / before_value : 0.0)});
+}
+
+void check_cuts(Verdict& v, const std::string& stage, const EvalResult& before, const EvalResult& after,
+                double max_loss_db) {
+  if (before.cost && after.cost) {
+    check_cut(v, stage, "params", before, after, static_cast<double>(before.cost->params),
+              static_cast<double>(after.cost->params), "params");
+    check_cut(v, stage, "MACs", before, after, static_cast<double>(before.cost->macs),
+              static_cast<double>(after.cost->macs), "MACs");
+  } else {
+    v.checks.push_back({stage + " cuts params and MACs", false, "no parameter or MAC count was evaluated"});
+  }
+  if (before.latency && after.latency) {
+    check_cut(v, stage, "latency", before, after, before.latency->median_ms, after.latency->median_ms, "ms");
+  } else {
+    v.checks.push_back({stage + " cuts latency", false, "latency was not measured (eval.latency_runs is 0)"});
+  }
+  const double loss = before.psnr - after.psnr;
+  v.checks.push_back({stage + " loses at most " + fmt::format("{:g}", max_loss_db) + " dB", loss <= max_loss_db,
+                      fmt::format("{}: {:.3f} dB -> {}: {:.3f} dB ({:+.3f} dB)", before.name, before.psnr, after.name,
+                                  after.psnr, -loss)});
+}
+
+// "a gains at least min_gain dB over b" on one PSNR (overall or a region of the frame); a PSNR
+// that was not evaluated fails the check.
+void check_gain(Verdict& v, const std::string& region, const EvalResult& a, const EvalResult& b,
+                std::optional<double> a_psnr, std::optional<double> b_psnr, double min_gain) {
+  const std::string claim = fmt::format("{} gains at least {:g} dB {} over {}", a.name, min_gain, region, b.name);
+  if (!a_psnr || !b_psnr) {
+    v.checks.push_back({claim, false, "PSNR " + region + " was not evaluated"});
+    return;
+  }
+  v.checks.push_back({claim, *a_psnr - *b_psnr >= min_gain,
+                      fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", *a_psnr, *b_psnr, *a_psnr - *b_psnr)});
+}
+
+// What the per-frame choice buys against the static network it chooses within.
+void check_dynamic_pruning(Verdict& v, const EvalResult& hybrid, const EvalResult& fixed, const EvalResult* magnitude,
+                           const VerdictOptions& options) {
+  const std::string latency_claim =
+      fmt::format("{} runs at most {:g}x its static network's mean latency", hybrid.name, options.max_hybrid_latency_ratio);
+  if (hybrid.latency && fixed.latency) {
+    const double ratio = hybrid.latency->mean_ms / fixed.latency->mean_ms;
+    v.checks.push_back({latency_claim, ratio <= options.max_hybrid_latency_ratio,
+                        fmt::format("{:.1f} ms against {:.1f} ms per frame ({:.2f}x; p95 {:.1f} against {:.1f} ms)",
+                                    hybrid.latency->mean_ms, fixed.latency->mean_ms, ratio, hybrid.latency->p95_ms,
+                                    fixed.latency->p95_ms)});
+  } else {
+    v.checks.push_back({latency_claim, false, "latency was not measured (eval.latency_runs is 0)"});
+  }
+  const double loss = fixed.psnr - hybrid.psnr;
+  v.checks.push_back({fmt::format("{} loses at most {:g} dB against its static network", hybrid.name,
+                                  options.max_hybrid_loss_db),
+                      loss <= options.max_hybrid_loss_db,
+                      fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", hybrid.psnr, fixed.psnr, -loss)});
+  if (magnitude) {
+    const double gain = hybrid.psnr - magnitude->psnr;
+    v.checks.push_back(
+        {fmt::format("{} gains at least {:g} dB over {}", hybrid.name, options.min_hybrid_gain_over_magnitude_db,
+                     magnitude->name),
+         gain >= options.min_hybrid_gain_over_magnitude_db,
+         fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB) at {:.3g} against {:.3g} MACs", hybrid.psnr,
+                     magnitude->psnr, gain, hybrid.cost ? static_cast<double>(hybrid.cost->macs) : 0.0,
+                     magnitude->cost ? static_cast<double>(magnitude->cost->macs) : 0.0)});
+  }
+  const auto choices = pattern_choices(hybrid);
+  const int used = choices ? static_cast<int>(choices->usage.size()) : 0;
+  v.checks.push_back({fmt::format("{} uses at least {} patterns on the test frames", hybrid.name,
+                                  options.min_patterns_used),
+                      used >= options.min_patterns_used, choices ? usage_text(*choices) : "no frame recorded a pattern"});
+}
+
+void check_beats_bicubic(Verdict& v, const std::vector<const EvalResult*>& networks, const EvalResult& bicubic,
+                         const std::string& where) {
+  for (const EvalResult* n : networks)
+    v.checks.push_back({n->name + " beats bicubic" + where, n->psnr > bicubic.psnr,
+                        fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", n->psnr, bicubic.psnr,
+                                    n->psnr - bicubic.psnr)});
+}
+
+}  // namespace
+
+Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) {
+  Verdict v;
+  if (r.bicubic) check_beats_bicubic(v, r.networks(), *r.bicubic, "");
+  if (r.control && r.cg_enhanced) {
+    check_gain(v, "overall", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr, r.control->psnr,
+               options.min_enhance_gain_db);
+    check_gain(v, "on geometry edges", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr_edge, r.control->psnr_edge,
+               options.min_enhance_edge_gain_db);
+  }
+  if (r.cg_enhanced && r.cg_optimized) check_cuts(v, "search", *r.cg_enhanced, *r.cg_optimized, options.max_search_loss_db);
+  if (r.cg_optimized && r.pruned) check_cuts(v, "pruning", *r.cg_optimized, *r.pruned, options.max_prune_loss_db);
+  if (r.pruned && r.pruned_static) check_dynamic_pruning(v, *r.pruned, *r.pruned_static, r.magnitude, options);
+  for (const auto& h : r.heldout) {
+    if (h.bicubic) {
+      check_beats_bicubic(v, h.networks, *h.bicubic, " on held-out scene '" + h.scene + "'");
+    } else {
+      v.checks.push_back({"bicubic evaluated on held-out scene '" + h.scene + "'", false, "no bicubic row there"});
+    }
+  }
+  return v;
+}
+
+bool Verdict::passed() const { return failed() == 0; }
+
+int Verdict::failed() const {
+  int n = 0;
+  for (const auto& c : checks) n += c.passed ? 0 : 1;
+  return n;
+}
+
+std::string Verdict::text() const {
+  std::string out;
+  for (const auto& c : checks) out += fmt::format("  [{}] {}: {}\n", c.passed ? "pass" : "FAIL", c.claim, c.detail);
+  out += passed() ? fmt::format("verdict: all {} checks pass\n", checks.size())
+                  : fmt::format("verdict: {} of {} checks FAILED\n", failed(), checks.size());
+  return out;
+}
+
+nlohmann::ordered_json Verdict::to_json() const {
+  nlohmann::ordered_json j;
+  j["passed"] = passed();
+  j["checks"] = nlohmann::ordered_json(checks);
+  return j;
+}
+
+}  // namespace cgsr

@@ -1,0 +1,81 @@
+#pragma once
+// The verdict of `cgsr run`: does this run show the CGSR story? Checks, on the held-out
+// evaluations of one run (all measured in the same process):
+//   - every network beats bicubic PSNR;
+//   - the CG-enhanced network beats the plain backbone trained on for the same steps (the
+//     control: what the extra training alone gives) by `min_enhance_gain_db` overall and by
+//     `min_enhance_edge_gain_db` on geometry-edge pixels, where rendering information should help;
+//   - the search cuts params, MACs and latency of the CG-enhanced network, losing at most
+//     `max_search_loss_db` PSNR;
+//   - pruning cuts params, MACs and latency of the searched network, losing at most
+//     `max_prune_loss_db` PSNR;
+//   - the dynamic part pays: the hybrid model's mean latency per frame (over the test frames in
+//     turn) is at most `max_hybrid_latency_ratio` of its static network's, it loses at most
+//     `max_hybrid_loss_db` against the static network, gains at least
+//     `min_hybrid_gain_over_magnitude_db` over magnitude pruning at its mean MACs, and uses at
+//     least `min_patterns_used` patterns on the test frames;
+//   - on every held-out scene (one the networks never trained on), every network beats bicubic.
+// Every figure in a check's detail comes from the evaluations; the thresholds are the config's.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/json_fields.h"
+#include "eval/evaluation.h"
+
+namespace cgsr {
+
+struct VerdictOptions {
+  double max_search_loss_db = 0.3;  // PSNR the CG-optimized network may lose against its parent
+  double max_prune_loss_db = 0.3;   // PSNR the pruned network may lose against its input
+  double min_enhance_gain_db = 0;       // PSNR the CG-enhanced network must gain over the control
+  double min_enhance_edge_gain_db = 0;  // the same on geometry-edge pixels
+  double max_hybrid_latency_ratio = 0.8;  // hybrid mean latency per frame against its static network's
+  double max_hybrid_loss_db = 0.05;       // PSNR the hybrid model may lose against its static network
+  double min_hybrid_gain_over_magnitude_db = 0.05;  // against magnitude pruning at the same mean MACs
+  int min_patterns_used = 3;              // distinct patterns chosen on the test frames
+  bool fail_run = true;             // a failed check makes `cgsr run` exit with an error
+};
+config::Schema<VerdictOptions> verdict_schema();
+
+// A held-out scene's evaluations: bicubic and the run's networks there.
+struct HeldoutScene {
+  std::string scene;
+  const EvalResult* bicubic = nullptr;
+  std::vector<const EvalResult*> networks;
+};
+
+// The evaluations a verdict needs, by role; a role left null is not checked.
+struct PipelineResults {
+  const EvalResult* bicubic = nullptr;
+  const EvalResult* backbone = nullptr;      // plain backbone (e.g. PAN x2)
+  const EvalResult* control = nullptr;       // the backbone trained on as long as the CG-enhanced one
+  const EvalResult* cg_enhanced = nullptr;   // backbone + RIT
+  const EvalResult* cg_optimized = nullptr;  // the search's pick, trained longer
+  const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network
+  const EvalResult* pruned_static = nullptr;  // the hybrid model's static network alone
+  const EvalResult* magnitude = nullptr;     // magnitude pruning at the hybrid's mean MACs
+  std::vector<HeldoutScene> heldout;
+  std::vector<const EvalResult*> networks() const;  // every non-null learned model
+};
+
+struct VerdictCheck {
+  std::string claim;   // e.g. "search cuts params"
+  bool passed = false;
+  std::string detail;  // the figures behind it
+};
+CGSR_JSON_FIELDS(VerdictCheck, claim, passed, detail)
+
+struct Verdict {
+  std::vector<VerdictCheck> checks;
+  bool passed() const;
+  int failed() const;
+  std::string text() const;  // one line per check, then a summary line
+  nlohmann::ordered_json to_json() const;
+};
+
+Verdict judge_pipeline(const PipelineResults& results, const VerdictOptions& options);
+
+}  // namespace cgsr
