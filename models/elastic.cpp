@@ -9,7 +9,8 @@
 #include "core/error.h"
 #include "core/text.h"
 #include "models/backbone_registry.h"
-#include "models/block_importance.h"
+#include "models/importance/block_importance.h"
+#include "models/importance/channel_importance.h"
 #include "models/inherit.h"
 
 namespace cgsr {
@@ -147,7 +148,7 @@ SubnetConfig ElasticSpace::repair(SubnetConfig sub) const {
 
 ElasticNetwork make_elastic(const SRNetworkImpl& net, const ElasticOptions& options) {
   std::map<std::string, std::vector<int64_t>> order;
-  for (const auto& [group, scores] : net.channel_importance()) {
+  for (const auto& [group, scores] : channel_importance(net)) {
     const auto s = scores.detach().to(torch::kDouble).contiguous();
     const double* p = s.data_ptr<double>();
     std::vector<int64_t> idx(s.numel());

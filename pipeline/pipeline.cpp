@@ -34,9 +34,19 @@ namespace fs = std::filesystem;
 namespace cgsr {
 
 const std::vector<std::string>& pipeline_stages() {
-  static const std::vector<std::string> stages = {"render", "train",  "enhance", "control", "search",
-                                                  "prune",  "export", "eval",    "heldout", "report"};
+  static const std::vector<std::string> stages = {"render", "train",    "enhance", "control", "elastic",
+                                                  "search", "prune",    "scratch", "controls", "export",
+                                                  "eval",   "heldout",  "report"};
   return stages;
+}
+
+config::Schema<ScratchOptions> scratch_schema() {
+  config::Schema<ScratchOptions> s;
+  s.field("enabled", &ScratchOptions::enabled, "train the CG-optimized architecture from scratch (a control)");
+  s.field("steps", &ScratchOptions::steps,
+          "its steps (0: as many as train, enhance, elastic and the search's fine-tuning together)")
+      .range(0, 100000000);
+  return s;
 }
 
 config::Schema<PipelineOptions> pipeline_schema() {
@@ -49,8 +59,14 @@ config::Schema<PipelineOptions> pipeline_schema() {
   s.block("train", &PipelineOptions::train, "cgsr train config of the plain backbone (data is filled in)");
   s.block("enhance", &PipelineOptions::enhance,
           "cgsr train config of the CG-enhanced network, its enhance block's rit and geometry at the top (data, model filled in)");
-  s.block("search", &PipelineOptions::search, "cgsr search config (parent, data filled in)");
+  s.block("elastic", &PipelineOptions::elastic,
+          "cgsr train config of the elastic network, its elastic block's keys at the top (data, model filled in)");
+  s.block("search", &PipelineOptions::search, "cgsr search config (model, data filled in)");
   s.block("prune", &PipelineOptions::prune, "cgsr prune config (model, data, eval filled in)");
+  s.section("scratch", &PipelineOptions::scratch, scratch_schema(),
+            "the CG-optimized architecture trained from scratch with the train stage's schedule");
+  s.section("controls", &PipelineOptions::controls, controls_schema(),
+            "the CG-enhanced network cut to the CG-optimized network's latency, fine-tuned alike");
   s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in (onnx, torchscript)");
   s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames; latency_runs: rounds of the report's side-by-side timing)");
   s.section("heldout", &PipelineOptions::heldout, heldout_schema(),
@@ -213,7 +229,8 @@ class Pipeline {
         root_(std::move(root)),
         stages_(root_, options.from,
                 static_cast<int>(pipeline_stages().size()) - (options.data.empty() ? 0 : 1) -
-                    (options.heldout.scenes.empty() ? 1 : 0)) {
+                    (options.heldout.scenes.empty() ? 1 : 0) - (options.scratch.enabled ? 0 : 1) -
+                    (options.controls.kinds.empty() ? 1 : 0)) {
     parse_stage_options();  // first: a mistake in a stage section is an error at its line
     results_["config"] = yaml_to_json(resolved);
   }
@@ -224,6 +241,8 @@ class Pipeline {
     train_networks();
     search();
     prune();
+    train_scratch();
+    cut_controls();
     export_networks();
     evaluate();
     evaluate_heldout();
@@ -270,12 +289,21 @@ class Pipeline {
     line("train", fmt::format("{} x{}, {}", backbone_.model, backbone_.scale, schedule(backbone_.schedule)));
     line("enhance", fmt::format("RIT from {}, {}", enum_name(enhanced_.enhance.rit.source), schedule(enhanced_.schedule)));
     line("control", "the same without the RIT");
-    line("search", fmt::format("{}, population {} over {} generations, candidates {}; the pick {}",
+    line("elastic", fmt::format("{} subnets per step, {}", elastic_.elastic.sampled + 1, schedule(elastic_.schedule)));
+    line("search", fmt::format("{}, population {} over {} generations{}; the pick within {:g} of the full latency, "
+                               "fine-tuned {}",
                                search_.search.strategy.type, search_.search.population, search_.search.generations,
-                               schedule(search_.candidate.schedule), schedule(search_.final_schedule)));
+                               search_.baseline.empty() ? "" : ", and " + search_.baseline + " search as many",
+                               search_.pick.latency_fraction, schedule(search_.final.schedule)));
     line("prune", fmt::format("{} patterns, fine-tuning {}", prune_.pool.keep_rates.size(),
                               prune_.finetune.epochs > 0 ? fmt::format("{} epochs", prune_.finetune.epochs)
                                                          : schedule(prune_.finetune.schedule)));
+    if (options_.scratch.enabled) line("scratch", fmt::format("the pick's architecture, {} steps", scratch_steps()));
+    if (!options_.controls.kinds.empty()) {
+      std::vector<std::string> kinds;
+      for (auto k : options_.controls.kinds) kinds.push_back(control_label(k));
+      line("controls", join(kinds) + " at the CG-optimized network's latency, " + schedule(search_.final.schedule));
+    }
     std::vector<std::string> formats;
     for (auto f : options_.export_formats) formats.push_back(enum_name(f));
     line("export", join(formats));
@@ -318,17 +346,25 @@ class Pipeline {
     enhanced_.enhance.enabled = true;
     control_ = enhanced_;  // same start, schedule, loss and seed; no rendering information
     control_.enhance.enabled = false;
+    YAML::Node elastic_filled = YAML::Clone(with_data);
+    elastic_filled["model"] = model_file("enhance").string();
+    elastic_ = parse_stage(options_.elastic, elastic_stage_schema(), elastic_filled, "elastic");
+    elastic_.elastic.enabled = true;
     YAML::Node search_filled = YAML::Clone(with_data);
-    search_filled["parent"] = model_file("enhance").string();
+    search_filled["model"] = model_file("elastic").string();
     search_ = parse_stage(options_.search, search_command_schema(), search_filled, "search");
+    // From scratch: the pick's architecture (the search writes it) with the train stage's schedule.
+    scratch_ = backbone_;
+    scratch_.model = (stages_.dir("search") / "pick_spec.yaml").string();
+    scratch_.schedule.steps = scratch_steps();
     eval_ = parse_stage(options_.eval, eval_schema_fields(), YAML::Node(YAML::NodeType::Map), "eval");
     // A distributed stage's other ranks are `cgsr search` / `cgsr train` processes (docs/distributed.md).
     for (const auto& [stage, rank] : {std::pair<const char*, int>{"train", backbone_.distributed.rank},
-                                      {"enhance", enhanced_.distributed.rank}, {"search", search_.distributed.rank}})
+                                      {"enhance", enhanced_.distributed.rank}, {"elastic", elastic_.distributed.rank}})
       if (rank != 0)
         throw Error(std::string(stage) + ".distributed.rank",
-                    "cgsr run is rank 0 of a distributed stage; start the other ranks with cgsr " +
-                        std::string(stage == std::string("search") ? "search" : "train") + " (docs/distributed.md)");
+                    "cgsr run is rank 0 of a distributed stage; start the other ranks with cgsr train "
+                    "(docs/distributed.md)");
     // The stages that evaluate (prune, eval, heldout) leave latency out: the report stage times
     // every model side by side, which is the only timing that compares.
     stage_eval_ = eval_;
@@ -355,30 +391,69 @@ class Pipeline {
   // The plain backbone; the CG-enhanced network (backbone + RIT, + geometry head) trained on from
   // it with the joint loss; and the control, the backbone trained on as long without the RIT.
   void train_networks() {
-    const auto train = [&](const std::string& stage, TrainOptions& o, const std::vector<std::string>& upstream) {
-      const auto outcome = stages_.run(stage, train_schema().emit(o), upstream, [&](RunDir& dir, bool resume) {
-        o.resume = resume;
-        return run_train(o, train_schema().emit(o), dir);
-      });
-      record(stage, outcome);
-      return outcome;
-    };
-    trained_ = train("train", backbone_, {data_hash_});
-    enhanced_stage_ = train("enhance", enhanced_, {data_hash_, trained_.hash});
+    trained_ = train_with(train_schema(), "train", backbone_, {data_hash_});
+    enhanced_stage_ = train_with(train_schema(), "enhance", enhanced_, {data_hash_, trained_.hash});
     control_.name = trained_.summary.at("name").get<std::string>() + " (control)";
-    control_stage_ = train("control", control_, {data_hash_, trained_.hash});
+    control_stage_ = train_with(train_schema(), "control", control_, {data_hash_, trained_.hash});
+    if (elastic_.name.empty()) elastic_.name = "elastic " + enhanced_stage_.summary.at("name").get<std::string>();
+    elastic_stage_ = train_with(elastic_stage_schema(), "elastic", elastic_, {data_hash_, enhanced_stage_.hash});
+  }
+
+  // Steps of the scratch control: what the pipeline gave the CG-optimized network's weights.
+  int scratch_steps() const {
+    if (options_.scratch.steps > 0) return options_.scratch.steps;
+    return backbone_.schedule.steps + enhanced_.schedule.steps + elastic_.schedule.steps + search_.final.schedule.steps;
+  }
+
+  // A training stage: `schema` emits the config it is recorded and hashed with.
+  StageOutcome train_with(const config::Schema<TrainOptions>& schema, const std::string& stage, TrainOptions& o,
+                          const std::vector<std::string>& upstream) {
+    const auto outcome = stages_.run(stage, schema.emit(o), upstream, [&](RunDir& dir, bool resume) {
+      o.resume = resume;
+      return run_train(o, schema.emit(o), dir);
+    });
+    record(stage, outcome);
+    return outcome;
+  }
+
+  // The CG-optimized network's architecture trained from random weights.
+  void train_scratch() {
+    if (!options_.scratch.enabled) return;
+    scratch_.name = roles_.input.name + " (scratch)";
+    scratched_ = train_with(train_schema(), "scratch", scratch_, {data_hash_, searched_.hash});
+  }
+
+  // The CG-enhanced network cut to the CG-optimized network's latency, fine-tuned alike.
+  void cut_controls() {
+    if (options_.controls.kinds.empty()) return;
+    ControlsJob job;
+    job.seed = options_.seed;
+    job.threads = options_.threads;
+    job.options = options_.controls;
+    job.enhanced = model_file("enhance").string();
+    job.final_model = model_file("search").string();
+    job.data = data_path_;
+    job.schedule = search_.final.schedule;
+    job.loss = search_.final.loss;
+    job.distill = search_.final.distill;
+    YAML::Node config = controls_schema().emit(options_.controls);
+    config["schedule"] = schedule_schema().emit(job.schedule);
+    config["loss"] = loss_schema().emit(job.loss);
+    config["distill"] = job.distill;
+    controlled_ = stages_.run("controls", config, {data_hash_, enhanced_stage_.hash, searched_.hash},
+                              [&](RunDir& dir, bool resume) { return run_controls(job, dir, resume); });
+    record("controls", controlled_);
+    for (const auto& c : controlled_.summary.at("controls"))
+      controls_.push_back({c.at("name").get<std::string>(), c.at("file").get<std::string>()});
   }
 
   // CG-enhanced -> CG-optimized.
   void search() {
     const YAML::Node resolved = search_command_schema().emit(search_);
-    searched_ = stages_.run(
-        "search", resolved, {data_hash_, enhanced_stage_.hash},
-        [&](RunDir& dir, bool resume) {
-          search_.resume = resume;
-          return run_search_command(search_, search_command_schema().emit(search_), dir);
-        },
-        search_config_cache_form(resolved));
+    searched_ = stages_.run("search", resolved, {data_hash_, elastic_stage_.hash}, [&](RunDir& dir, bool resume) {
+      search_.resume = resume;
+      return run_search_command(search_, search_command_schema().emit(search_), dir);
+    });
     record("search", searched_);
   }
 
@@ -401,8 +476,11 @@ class Pipeline {
     const Resolution lr = data_->info().resolutions.front();
     const fs::path pruned_file = model_file("prune");
     std::vector<std::pair<fs::path, std::string>> to_export = {
-        {model_file("train"), "backbone"}, {model_file("enhance"), "cg_enhanced"}, {model_file("search"), "cg_optimized"}};
+        {model_file("train"), "backbone"}, {model_file("enhance"), "cg_enhanced"}, {model_file("elastic"), "elastic"},
+        {model_file("search"), "cg_optimized"}};
     for (const auto& b : roles_.baselines) to_export.emplace_back(b.file, b.file.stem().string());
+    if (options_.scratch.enabled) to_export.emplace_back(model_file("scratch"), "scratch");
+    for (const auto& c : controls_) to_export.emplace_back(c.file, "control_" + c.file.stem().string());
     to_export.emplace_back(pruned_file, "pruned");
     std::vector<ExportCommandOptions> exports;
     YAML::Node export_config(YAML::NodeType::Sequence);
@@ -429,7 +507,9 @@ class Pipeline {
         export_config.push_back(export_schema().emit(e));
       }
     }
-    exported_ = stages_.run("export", export_config, {trained_.hash, enhanced_stage_.hash, searched_.hash, pruned_.hash},
+    exported_ = stages_.run("export", export_config,
+                            {trained_.hash, enhanced_stage_.hash, elastic_stage_.hash, searched_.hash, pruned_.hash,
+                             scratched_.hash, controlled_.hash},
                             [&](RunDir&, bool) {
                               nlohmann::ordered_json j = nlohmann::ordered_json::array();
                               for (const auto& e : exports) j.push_back(run_export(e));
@@ -448,9 +528,12 @@ class Pipeline {
     evaluation.scale = backbone_.scale;
     evaluation.eval = stage_eval_;
     evaluation.models = classic_models();
-    for (const std::string stage : {"train", "control", "enhance"}) evaluation.models.push_back(model_file(stage).string());
+    for (const std::string stage : {"train", "control", "enhance", "elastic"})
+      evaluation.models.push_back(model_file(stage).string());
+    for (const auto& extra : control_models()) evaluation.models.push_back(extra.file.string());
     evaluated_ = stages_.run("eval", eval_schema().emit(evaluation),
-                             {data_hash_, trained_.hash, control_stage_.hash, enhanced_stage_.hash},
+                             {data_hash_, trained_.hash, control_stage_.hash, enhanced_stage_.hash, elastic_stage_.hash,
+                              scratched_.hash, controlled_.hash},
                              [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
     record("eval", evaluated_);
   }
@@ -463,6 +546,7 @@ class Pipeline {
     for (const std::string stage : {"train", "control", "enhance", "search"}) job.models.push_back(model_file(stage).string());
     for (const auto& b : roles_.baselines) job.models.push_back(b.file.string());
     job.models.push_back(model_file("prune").string());
+    for (const auto& extra : control_models()) job.models.push_back(extra.file.string());
     job.scale = backbone_.scale;
     job.lr = data_->info().resolutions.front();
     job.training_scene = data_->info().name;
@@ -472,9 +556,19 @@ class Pipeline {
     YAML::Node config = heldout_schema().emit(options_.heldout);
     config["models"] = job.models;
     heldout_ = stages_.run(
-        "heldout", config, {trained_.hash, control_stage_.hash, enhanced_stage_.hash, searched_.hash, pruned_.hash},
+        "heldout", config,
+        {trained_.hash, control_stage_.hash, enhanced_stage_.hash, searched_.hash, pruned_.hash, scratched_.hash,
+         controlled_.hash},
         [&](RunDir& dir, bool) { return run_heldout(options_.heldout, job, dir.path()); });
     record("heldout", heldout_);
+  }
+
+  // The scratch network and the controls of equal latency, with their display names.
+  std::vector<PrunedModel> control_models() const {
+    std::vector<PrunedModel> out;
+    if (options_.scratch.enabled) out.push_back({scratch_.name, model_file("scratch")});
+    out.insert(out.end(), controls_.begin(), controls_.end());
+    return out;
   }
 
   std::vector<std::string> classic_models() const {
@@ -518,6 +612,8 @@ class Pipeline {
                                              {roles_.hybrid.name, model_file("prune")},
                                              {roles_.static_network.name, model_file("prune")}};
     for (const auto& b : roles_.baselines) files[b.name] = b.file;
+    files[elastic_.name] = model_file("elastic");
+    for (const auto& extra : control_models()) files[extra.name] = extra.file;
     return files;
   }
 
@@ -570,6 +666,13 @@ class Pipeline {
     roles.pruned = find_result(own_, roles_.hybrid.name);
     roles.pruned_static = find_result(own_, roles_.static_network.name);
     if (const auto* mmp = roles_.baseline("magnitude")) roles.magnitude = find_result(own_, mmp->name);
+    roles.elastic = find_result(own_, elastic_.name);
+    if (options_.scratch.enabled) roles.scratch = find_result(own_, scratch_.name);
+    for (const auto& c : controls_)
+      if (const auto* r = find_result(own_, c.name)) roles.controls.push_back(r);
+    const auto& searches = searched_.summary.at("searches");
+    for (const auto& [strategy, stats] : searches.items())
+      roles.searches.push_back({strategy, stats.at("evaluations").get<int>(), stats.at("hypervolume").get<double>()});
     if (!roles.bicubic || !roles.backbone || !roles.control || !roles.cg_enhanced || !roles.cg_optimized || !roles.pruned)
       throw Error(root_.string(), "the evaluations miss a model of the pipeline (searched: " + roles_.input.name + ")",
                   ErrorKind::Internal);
@@ -582,6 +685,8 @@ class Pipeline {
       HeldoutScene h{scene, row("bicubic"), {}};
       for (const EvalResult* n : roles.networks())
         if (const EvalResult* r = row(n->name)) h.networks.push_back(r);
+      if (roles.cg_optimized) h.cg_optimized = row(roles.cg_optimized->name);
+      if (roles.scratch) h.scratch = row(roles.scratch->name);
       roles.heldout.push_back(std::move(h));
     }
     return judge_pipeline(roles, options_.verdict);
@@ -596,7 +701,7 @@ class Pipeline {
   bool rendering_ = false;
   std::string data_path_;
   RenderOptions scene_;
-  TrainOptions backbone_, enhanced_, control_;
+  TrainOptions backbone_, enhanced_, control_, elastic_, scratch_;
   SearchCommandOptions search_;
   PruneCommandOptions prune_;
   EvalOptions eval_, stage_eval_;
@@ -604,8 +709,10 @@ class Pipeline {
   // What the stages leave for later ones.
   std::string data_hash_;
   std::unique_ptr<Dataset> data_;
-  StageOutcome trained_, enhanced_stage_, control_stage_, searched_, pruned_, exported_, evaluated_, heldout_;
+  StageOutcome trained_, enhanced_stage_, control_stage_, elastic_stage_, searched_, pruned_, scratched_, controlled_,
+      exported_, evaluated_, heldout_;
   PruneRoles roles_;
+  std::vector<PrunedModel> controls_;  // the controls of equal latency
   std::map<std::string, fs::path> onnx_of_file_;  // model file -> its exported ONNX file
   std::vector<EvalResult> own_, unseen_;          // the report's rows: the run's data set, held-out scenes
 };

@@ -7,8 +7,15 @@
 //   enhance  backbone + RIT + geometry head (CG-enhanced)     DIR/enhance
 //   control  the backbone trained on with the enhance stage's schedule and seed: what the
 //            extra training alone gives, which the verdict compares CG-enhanced with   DIR/control
-//   search   CG-enhanced -> CG-optimized                      DIR/search
+//   elastic  the CG-enhanced network trained once as an elastic network: every subnet of its
+//            space works; its latency table measured                             DIR/elastic
+//   search   evolution over the elastic network's subnets by inference (and random search at
+//            as many evaluations); the pick, fine-tuned with distillation: CG-optimized  DIR/search
 //   prune    hybrid pruning + magnitude baseline              DIR/prune
+//   scratch  the pick's architecture trained from scratch for as many steps as the pipeline
+//            gave the CG-optimized network (train, enhance, elastic, fine-tuning)   DIR/scratch
+//   controls the CG-enhanced network cut by magnitude to the CG-optimized network's latency
+//            (MMP, uniform width), fine-tuned alike (pipeline/controls_stage.h)   DIR/controls
 //   export   ONNX + TorchScript of the final networks, verified in other runtimes   DIR/export
 //   eval     classic baselines, backbone, control and CG-enhanced on the test split  DIR/eval
 //   heldout  scenes not in the training data (when `heldout.scenes` names any): every model and
@@ -29,18 +36,29 @@
 
 #include "core/config.h"
 #include "export/export_format.h"
+#include "pipeline/controls_stage.h"
 #include "pipeline/heldout_evaluation.h"
 #include "pipeline/run_settings.h"
 #include "pipeline/verdict.h"
 
 namespace cgsr {
 
+// The scratch control: the CG-optimized network's architecture trained from random weights with
+// the train stage's schedule.
+struct ScratchOptions {
+  bool enabled = true;
+  int steps = 0;  // 0: as many as train + enhance + elastic + the search's fine-tuning
+};
+config::Schema<ScratchOptions> scratch_schema();
+
 struct PipelineOptions : RunSettings {
   std::string name = "quickstart";  // default run directory runs/<name>
   std::string scene;                // cgsr render config of the scene to render...
   std::string data;                 // ...or an existing data set (then there is no render stage)
   std::vector<std::string> baselines = {"bicubic"};  // classic upscalers in the report (bicubic is always added)
-  config::Block train, enhance, search, prune;      // the subcommands' configs, paths filled in
+  config::Block train, enhance, elastic, search, prune;  // the subcommands' configs, paths filled in
+  ScratchOptions scratch;
+  ControlsOptions controls;
   std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
   config::Block eval;                // EvalOptions shared by the eval and prune stages
   HeldoutOptions heldout;            // scenes never trained on, evaluated with every model

@@ -1,187 +1,194 @@
 #include "pipeline/search_stage.h"
 
-#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "core/atomic_file.h"
-#include "core/hash.h"
+#include <algorithm>
+#include <limits>
+
 #include "core/plot.h"
 #include "core/yaml_json.h"
-#include "models/importance/block_importance.h"
-#include "models/inherit.h"
+#include "models/complexity.h"
+#include "models/elastic.h"
 #include "models/model_file.h"
-#include "pipeline/distributed_run.h"
-#include "pipeline/distributed_search.h"
+#include "models/subnet.h"
 #include "render_data/dataset.h"
+#include "train/distillation.h"
 
 namespace cgsr {
 
-config::Schema<SearchCommandOptions> search_command_schema() {
-  config::Schema<SearchCommandOptions> s;
-  s.field("parent", &SearchCommandOptions::parent, "CG-enhanced model file to start from").required();
-  s.field("data", &SearchCommandOptions::data, "data set directory").required();
-  s.inline_section(&SearchCommandOptions::search, search_schema());
-  // Configs before the search options moved up: `search: {strategy: ...}`; the inlined options'
-  // upgrade (a former `operators:` block) then reads it whether lifted from there or at the top.
-  s.moved_block("search");
-  s.section("candidate", &SearchCommandOptions::candidate, candidate_training_schema(), "training of each candidate");
-  s.section("final", &SearchCommandOptions::final_schedule, schedule_schema(), "training of the picked network");
-  s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
-  s.field("resume", &SearchCommandOptions::resume, "continue from history.jsonl and the final checkpoint");
-  s.section("distributed", &SearchCommandOptions::distributed, distributed::distributed_schema(),
-            "train candidates on several processes or machines (docs/distributed.md)");
-  add_run_settings(s);
+namespace {
+config::Schema<PickOptions> pick_schema() {
+  config::Schema<PickOptions> s;
+  s.field("latency_fraction", &PickOptions::latency_fraction,
+          "latency budget of the pick, as a fraction of the full network's predicted latency").range(0.001, 1);
+  s.field("latency_ms", &PickOptions::latency_ms, "latency budget in ms (when > 0; replaces latency_fraction)")
+      .at_least(0);
   return s;
 }
 
-YAML::Node search_config_cache_form(const YAML::Node& resolved) {
-  const auto search_keys = search_schema().keys();
-  const auto is_search_key = [&](const std::string& key) {
-    return std::find(search_keys.begin(), search_keys.end(), key) != search_keys.end();
-  };
-  // The search block as it was: the strategy's name, and evolution's options in `operators:`
-  // after `space:` (for every strategy: the random one ignored them).
-  YAML::Node search(YAML::NodeType::Map);
-  for (const auto& kv : resolved) {
-    const std::string key = kv.first.Scalar();
-    if (!is_search_key(key)) continue;
-    if (key == "strategy") {
-      search[key] = kv.second["type"];
-      continue;
-    }
-    search[key] = kv.second;
-    if (key != "space") continue;
-    YAML::Node operators = evolution_schema().emit(EvolutionOptions{});
-    if (resolved["strategy"]["type"].Scalar() == "evolution")
-      for (const auto& option : resolved["strategy"])
-        if (option.first.Scalar() != "type") operators[option.first.Scalar()] = option.second;
-    search["operators"] = operators;
-  }
-  YAML::Node out(YAML::NodeType::Map);
-  bool placed = false;
-  for (const auto& kv : resolved) {
-    const std::string key = kv.first.Scalar();
-    if (!is_search_key(key)) {
-      out[key] = kv.second;
-    } else if (!placed) {
-      out["search"] = search;  // the block sat where its first key sits now
-      placed = true;
-    }
-  }
-  return out;
+config::Schema<FinalTraining> final_schema() {
+  config::Schema<FinalTraining> s;
+  s.section("schedule", &FinalTraining::schedule, schedule_schema(), "fine-tuning of the pick (steps: 0 for none)");
+  s.section("loss", &FinalTraining::loss, loss_schema(), "its loss");
+  s.field("distill", &FinalTraining::distill, "weight of the full network's output beside the HR frame's").range(0, 100);
+  return s;
 }
 
-namespace {
-void write_population_plot(const std::filesystem::path& path, const SearchResult& result) {
+nlohmann::ordered_json candidate_json(const Candidate& c) {
+  return {{"key", c.key}, {"generation", c.generation}, {"quality", c.quality}, {"score", c.score},
+          {"subnet", to_json(c.subnet)}};
+}
+
+struct SearchRun {
+  std::string strategy;
+  SearchResult result;
+  double hypervolume = 0;
+};
+
+void write_front_plot(const std::filesystem::path& path, const std::vector<SearchRun>& runs, const Candidate& full,
+                      const Candidate& pick, double budget_ms) {
   ScatterPlot plot;
-  plot.title = "search: validation PSNR against parameters";
-  plot.x_label = "parameters (k)";
+  plot.title = "search: validation quality against predicted latency";
+  plot.x_label = "predicted latency (ms)";
   plot.y_label = "validation PSNR (dB)";
-  PlotSeries candidates{"candidate", {90, 140, 220}, 4, false, {}};
-  for (const auto& c : result.evaluated) candidates.points.push_back({c.score.params / 1000.0, c.score.val_psnr, ""});
-  PlotSeries parent{"CG-enhanced parent", {30, 30, 30}, 7, false,
-                    {{result.parent.score.params / 1000.0, result.parent.score.val_psnr, "parent"}}};
-  PlotSeries pick{"pick (smallest within tolerance)", {220, 40, 40}, 7, false,
-                  {{result.pick.score.params / 1000.0, result.pick.score.val_psnr, "pick"}}};
-  plot.series = {candidates, parent, pick};
+  const std::vector<Rgb> dots = {{120, 160, 230}, {190, 190, 190}}, lines = {{30, 70, 170}, {110, 110, 110}};
+  for (size_t r = 0; r < runs.size(); ++r) {
+    PlotSeries all{runs[r].strategy + " (" + std::to_string(runs[r].result.evaluated.size()) + " subnets)", dots[r % 2],
+                   2, false, {}};
+    for (const auto& c : runs[r].result.evaluated)
+      if (!c.failed) all.points.push_back({c.score.latency_ms, c.quality, ""});
+    PlotSeries front{runs[r].strategy + " front", lines[r % 2], 4, true, {}};
+    for (const auto& c : runs[r].result.front) front.points.push_back({c.score.latency_ms, c.quality, ""});
+    plot.series.push_back(all);
+    plot.series.push_back(front);
+  }
+  plot.series.push_back({"full network", {20, 20, 20}, 7, false, {{full.score.latency_ms, full.quality, "full"}}});
+  plot.series.push_back({"pick", {220, 40, 40}, 7, false, {{pick.score.latency_ms, pick.quality, "pick"}}});
+  plot.notes.push_back("latency budget " + fmt::format("{:.1f}", budget_ms) + " ms");
   write_scatter_plot(path, plot);
 }
 }  // namespace
 
+config::Schema<SearchCommandOptions> search_command_schema() {
+  config::Schema<SearchCommandOptions> s;
+  s.field("model", &SearchCommandOptions::model, "elastic model file (cgsr train with elastic.enabled)").required();
+  s.field("data", &SearchCommandOptions::data, "data set directory").required();
+  s.inline_section(&SearchCommandOptions::search, search_schema());
+  s.field("baseline", &SearchCommandOptions::baseline,
+          "a strategy run with as many evaluations, the search's control (\"\": none)");
+  s.section("crops", &SearchCommandOptions::crops, validation_crop_schema(), "the validation crops subnets are scored on");
+  s.section("pick", &SearchCommandOptions::pick, pick_schema(), "which subnet of the front becomes the network");
+  s.section("final", &SearchCommandOptions::final, final_schema(), "fine-tuning of the pick, distilled from the full network");
+  s.field("name", &SearchCommandOptions::name, "display name of the result in reports");
+  s.field("resume", &SearchCommandOptions::resume, "continue from the histories and the final checkpoint");
+  s.validate([](const SearchCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.baseline.empty() && !strategy_registry().contains(o.baseline))
+      at.child("baseline").fail(node["baseline"], "unknown search strategy '" + o.baseline + "'; valid: " +
+                                                      join(strategy_registry().names()));
+  });
+  add_run_settings(s);
+  return s;
+}
+
 nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
                                           RunDir& run_dir) {
-  Model parent = load_model(options.parent);
-  // Candidates read a subset of the parent's channels (their geometry targets too, at HR).
-  const Dataset data = open_for_channels(options.data, parent.network->input_channels());
-  if (!parent.network->has_rit())
-    spdlog::warn("{}: the parent has no RIT block; the search runs on the plain backbone", options.parent);
+  Model elastic = load_model(options.model);
+  const ElasticSpace space = elastic_space_from(elastic.network->spec(), elastic.provenance.extra, options.model);
+  if (!elastic.provenance.extra.contains("latency_table"))
+    throw Error(options.model, "has no latency table (train it with elastic.enabled)");
+  const LatencyTable table = latency_table_from_json(elastic.provenance.extra.at("latency_table"), options.model);
+  std::vector<RenderChannel> channels = elastic.network->input_channels();
+  channels.push_back(RenderChannel::Edge);
+  const Dataset data = open_for_channels(options.data, channels);
+  InferenceEvaluator evaluator(elastic.network, data, options.crops, table);
+  spdlog::info("search: {} elastic layer groups, {} blocks (at least {}); scoring on {} validation crops; latency "
+               "table at {}x{} (prediction error {:.1f}% mean, {:.1f}% max)",
+               space.genes().size(), space.total_blocks(), space.min_blocks(), evaluator.crops(), table.lr_width,
+               table.lr_height, table.error.mean_abs_percent, table.error.max_abs_percent);
 
-  std::vector<int> drop_order;
-  if (options.search.space.drop_blocks == BlockDrop::Importance && parent.network->spec().blocks > 0) {
-    drop_order = block_drop_order(*parent.network);
-    spdlog::info("search: shallower candidates drop the parent's blocks in the order {} (least important first)",
-                 fmt::join(drop_order, ", "));
+  Candidate full;
+  full.subnet = space.full();
+  full.key = subnet_key(full.subnet);
+  full.score = evaluator.evaluate(full.subnet);
+  full.quality = candidate_quality(full.score, options.search.edge_weight);
+
+  std::vector<SearchRun> runs;
+  std::vector<std::pair<std::string, std::string>> plan = {{options.search.strategy.type, "history.jsonl"}};
+  if (!options.baseline.empty()) plan.emplace_back(options.baseline, options.baseline + "_history.jsonl");
+  for (const auto& [strategy, file] : plan) {
+    SearchOptions o = options.search;
+    if (strategy != o.strategy.type) o.strategy = StrategyOptions{strategy, {}};
+    SearchHistory history(run_dir.file(file), options.resume);
+    runs.push_back({strategy, run_search(space, evaluator, history, o, strategy), 0});
   }
-  TrainingEvaluator local(parent.network, data, options.candidate, drop_order);
-  // Rank 0 opens the history before the others join: a refused --out fails before they wait.
-  std::optional<SearchHistory> history;
-  if (!options.distributed.enabled() || options.distributed.rank == 0)
-    history.emplace(run_dir.file("history.jsonl"), options.resume);
-  std::unique_ptr<distributed::World> world;
-  std::optional<distributed::WorkQueue> queue;
-  std::optional<DistributedEvaluator> distributed_evaluator;
-  if (options.distributed.enabled()) {
-    // What a candidate's score depends on: every rank must agree on it.
-    const std::string job = std::to_string(fnv1a64(read_file(options.parent))) + "\n" +
-                            std::to_string(data.frames(Split::Train).size()) + " " +
-                            std::to_string(data.frames(Split::Val).size()) + "\n" + std::to_string(options.seed) +
-                            "\n" + config::to_yaml(candidate_training_schema().emit(options.candidate));
-    world = join_run(options.distributed, job);
-    queue.emplace(*world);
-    if (options.candidate.schedule.layout == MemoryLayout::Auto)
-      spdlog::warn("candidate.schedule.layout is auto: each process measures its own memory layout, so a score can "
-                   "differ in the last digits from a 1-process run (set nchw or nhwc for identical ones)");
-    if (!world->coordinator()) {
-      const int trained = serve_candidates(*queue, local);
-      spdlog::info("distributed: {} trained {} candidate(s); rank 0 records the search", world->describe(), trained);
-      nlohmann::ordered_json j;
-      j["rank"] = world->rank();
-      j["world_size"] = world->size();
-      j["candidates_trained"] = trained;
-      return j;
-    }
-    distributed_evaluator.emplace(local, *queue);
-  }
-  Evaluator& evaluator = distributed_evaluator ? static_cast<Evaluator&>(*distributed_evaluator) : local;
+  // One reference for every front: the full network's latency, the worst quality any run saw.
+  double quality_ref = full.quality;
+  for (const auto& r : runs)
+    for (const auto& c : r.result.evaluated)
+      if (!c.failed) quality_ref = std::min(quality_ref, c.quality);
+  const double latency_ref = full.score.latency_ms;
+  for (auto& r : runs) r.hypervolume = front_hypervolume(r.result.front, latency_ref, quality_ref);
 
-  SearchResult result;
-  try {
-    result = run_search(parent.network->spec(), evaluator, *history, options.search);
-  } catch (const std::exception& e) {
-    if (queue) queue->abort(e.what());
-    throw;
-  }
-  if (queue) queue->finish();  // the other ranks return; rank 0 trains the pick alone
-  write_population_plot(run_dir.file("population.png"), result);
-  if (result.pick_is_parent)
-    spdlog::warn("no candidate stayed within {} dB of the parent; the parent is kept", options.search.tolerance_db);
+  const double budget = options.pick.latency_ms > 0 ? options.pick.latency_ms
+                                                    : options.pick.latency_fraction * full.score.latency_ms;
+  const Candidate pick = pick_within(runs.front().result.front, budget);
+  write_front_plot(run_dir.file("front.png"), runs, full, pick, budget);
+  spdlog::info("search: pick {} at {:.1f} ms predicted ({:.0f}% of the full network's {:.1f} ms), {:.3f} dB "
+               "(full: {:.3f} dB)", pick.key, pick.score.latency_ms, 100.0 * pick.score.latency_ms / latency_ref,
+               latency_ref, pick.quality, full.quality);
 
-  // The CG-optimized network: the pick, inherited from the parent and trained longer.
-  SRNetwork picked = inherit(*parent.network, result.pick.spec, {}, local.parent_blocks(result.pick.spec)).network;
-  Trainer trainer(picked, data, options.final_schedule, options.candidate.loss);
-  const TrainOutcome final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
-
+  // The CG-optimized network: the pick as a network of its own, fine-tuned from the full one.
+  SRNetwork picked = materialize_subnet(*elastic.network, pick.subnet);
   const std::string name = options.name.empty() ? "CG-optimized " + spec_summary(picked->spec()) : options.name;
   Provenance provenance;
   provenance.stage = "search";
-  provenance.parent = options.parent;
+  provenance.parent = options.model;
   provenance.config = yaml_to_json(resolved);
-  provenance.metrics = {{"val_psnr", final_training.best.psnr}, {"val_ssim", final_training.best.ssim}};
-  provenance.extra = {{"name", name}, {"data", data.info().root.string()}};
+  provenance.extra = {{"name", name}, {"data", data.info().root.string()}, {"subnet", to_json(pick.subnet)}};
+  save_model(run_dir.file("subnet.cgsr"), *picked, provenance);
+  save_spec_file(run_dir.file("pick_spec.yaml"), picked->spec());  // what the scratch control trains
+  std::optional<TrainOutcome> final_training;
+  if (options.final.schedule.steps > 0) {
+    TrainHooks hooks;
+    if (options.final.distill > 0)
+      hooks = distillation_hooks(elastic.network, options.final.distill, options.final.loss.image_norm);
+    Trainer trainer(picked, data, options.final.schedule, options.final.loss, {}, hooks);
+    final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
+    provenance.metrics = {{"val_psnr", final_training->best.psnr}, {"val_ssim", final_training->best.ssim}};
+  }
   save_model(run_dir.file("model.cgsr"), *picked, provenance);
-
-  const double reduction = 1.0 - static_cast<double>(result.pick.score.params) / result.parent.score.params;
-  spdlog::info("search: {} -> {} params ({:.1f}% fewer; paper, Fig. 6(b): 37%), {} candidates in {} generations ({})",
-               result.parent.score.params, result.pick.score.params, 100.0 * reduction, result.evaluated.size(),
-               result.generations_run, result.stop_reason);
 
   nlohmann::ordered_json j;
   j["name"] = name;
   j["model"] = run_dir.file("model.cgsr").string();
-  j["parent"] = {{"spec", spec_summary(result.parent.spec)}, {"score", result.parent.score}};
-  j["pick"] = {{"spec", spec_summary(result.pick.spec)},
-               {"spec_yaml", spec_to_yaml(result.pick.spec)},
-               {"score", result.pick.score},
-               {"is_parent", result.pick_is_parent}};
-  j["param_reduction"] = reduction;
-  j["pareto_front"] = nlohmann::ordered_json::array();
-  for (const auto& c : pareto_front(result.evaluated))
-    j["pareto_front"].push_back({{"spec", spec_summary(c.spec)}, {"params", c.score.params}, {"val_psnr", c.score.val_psnr}});
-  j["candidates"] = result.evaluated.size();
-  j["generations"] = result.generations_run;
-  j["stop_reason"] = result.stop_reason;
-  j["final_training"] = to_json(final_training);
-  if (world) j["world_size"] = world->size();
+  j["subnet_model"] = run_dir.file("subnet.cgsr").string();
+  j["elastic"] = options.model;
+  j["latency_table"] = {{"lr_size", {table.lr_width, table.lr_height}},
+                        {"convolution_shapes", table.conv_ms.size()},
+                        {"prediction_error", {{"subnets", table.error.subnets},
+                                              {"mean_abs_percent", table.error.mean_abs_percent},
+                                              {"max_abs_percent", table.error.max_abs_percent}}}};
+  j["crops"] = evaluator.crops();
+  j["full"] = candidate_json(full);
+  j["hypervolume_reference"] = {{"latency_ms", latency_ref}, {"quality", quality_ref}};
+  for (const auto& r : runs) {
+    nlohmann::ordered_json s;
+    s["evaluations"] = r.result.evaluated.size();
+    s["generations"] = r.result.generations_run;
+    s["failures"] = r.result.failures;
+    s["stop_reason"] = r.result.stop_reason;
+    s["hypervolume"] = r.hypervolume;
+    s["front"] = nlohmann::ordered_json::array();
+    for (const auto& c : r.result.front) s["front"].push_back(candidate_json(c));
+    j["searches"][r.strategy] = s;
+    spdlog::info("search: {}: {} subnets, front of {}, hypervolume {:.2f} dB ms", r.strategy, r.result.evaluated.size(),
+                 r.result.front.size(), r.hypervolume);
+  }
+  j["pick"] = candidate_json(pick);
+  j["pick"]["budget_ms"] = budget;
+  j["pick"]["spec"] = spec_summary(picked->spec());
+  j["pick"]["params"] = inference_parameter_count(*picked);
+  if (final_training) j["final_training"] = to_json(*final_training);
   return j;
 }
 

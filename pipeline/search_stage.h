@@ -1,37 +1,48 @@
 #pragma once
-// The search job: what `cgsr search` runs, and the search stage of `cgsr run`. The CG-guided
-// architecture search starts from a CG-enhanced model file, evolves smaller specs
-// (search/search_loop.h), trains the pick longer and writes it as model.cgsr. history.jsonl
-// records every candidate and is the checkpoint of resume.
+// The search job: what `cgsr search` runs, and the search stage of `cgsr run`: the CG-guided
+// architecture search over the subnets of an elastic network (one trained with `cgsr train` and
+// `elastic.enabled`). Evolution (NSGA-II) scores subnets by
+// inference on validation crops against the latency table stored with the network, and random
+// search with as many evaluations is its control; both fronts, their hypervolumes and a plot are
+// written. The pick, the best subnet within the latency budget, is materialized as a network of
+// its own and fine-tuned with distillation from the full network: model.cgsr.
+// history.jsonl (and random_history.jsonl) record every subnet and are the checkpoint of --resume.
 
 #include <nlohmann/json.hpp>
 
 #include "core/run_dir.h"
-#include "distributed/world.h"
 #include "pipeline/run_settings.h"
-#include "pipeline/training_evaluator.h"
 #include "search/search_loop.h"
+#include "search/subnet_evaluator.h"
+#include "train/losses.h"
+#include "train/trainer.h"
 
 namespace cgsr {
 
+struct PickOptions {
+  double latency_fraction = 0.33;  // budget: this fraction of the full network's predicted latency
+  double latency_ms = 0;           // or this many ms (when > 0)
+};
+
+struct FinalTraining {
+  TrainSchedule schedule;  // fine-tuning of the pick (0 steps: none)
+  LossOptions loss;
+  double distill = 1.0;    // weight of the full network's output beside the HR frame's 1
+};
+
 struct SearchCommandOptions : RunSettings {
-  std::string parent;  // CG-enhanced model file (required)
-  std::string data;    // data set directory (required)
-  SearchOptions search;  // its keys sit at the top level of the config
-  CandidateTraining candidate;
-  TrainSchedule final_schedule;  // training of the pick (paper: 30 epochs)
-  std::string name;              // display name of the result
+  std::string model;  // elastic model file (required)
+  std::string data;   // data set directory (required)
+  SearchOptions search;                    // its keys sit at the top level of the config
+  std::string baseline = "random";         // a strategy run with as many evaluations ("": none)
+  ValidationCropOptions crops;
+  PickOptions pick;
+  FinalTraining final;
+  std::string name;   // display name of the result
   bool resume = false;
-  distributed::DistributedOptions distributed;  // candidates spread over processes (docs/distributed.md)
 };
 
 config::Schema<SearchCommandOptions> search_command_schema();
-
-// A resolved `cgsr search` config in the shape it had before the search options moved to the top
-// level and each strategy got its own options block (`search: {strategy: evolution, operators:
-// {...}}`): the search stage of `cgsr run` hashes this form, so run directories made before stay
-// current when nothing but the shape changed.
-YAML::Node search_config_cache_form(const YAML::Node& resolved);
 nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, const YAML::Node& resolved,
                                           RunDir& run_dir);
 

@@ -6,7 +6,9 @@
 #include "core/hash.h"
 #include "core/yaml_json.h"
 #include "models/complexity.h"
+#include "models/elastic.h"
 #include "models/inherit.h"
+#include "models/latency_table.h"
 #include "models/model_file.h"
 #include "models/model_source.h"
 #include "pipeline/distributed_run.h"
@@ -32,6 +34,7 @@ config::Schema<TrainOptions> train_schema_with(
   s.field("scale", &TrainOptions::scale, "upscaling factor (must match a model file)").range(2, 4);
   s.field("name", &TrainOptions::name, "display name in reports");
   add_enhancement(s);
+  s.section("distill", &TrainOptions::distill, distill_schema(), "learn a teacher network's output too");
   s.section("schedule", &TrainOptions::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &TrainOptions::loss, loss_schema(), "CGSR loss weights");
   s.field("resume", &TrainOptions::resume, "continue from checkpoint.pt in the run directory");
@@ -58,6 +61,8 @@ YAML::Node drop_enabled(const YAML::Node& map, const config::Cursor& at) {
 config::Schema<TrainOptions> train_schema() {
   return train_schema_with([](config::Schema<TrainOptions>& s) {
     s.section("enhance", &TrainOptions::enhance, enhance_schema(/*with_enabled=*/true), "make a CG-enhanced network");
+    s.section("elastic", &TrainOptions::elastic, elastic_training_schema(/*with_enabled=*/true),
+              "train an elastic network: every subnet of its space works (sandwich rule, in-place distillation)");
   });
 }
 
@@ -66,6 +71,12 @@ config::Schema<TrainOptions> enhance_stage_schema() {
     s.inline_section(&TrainOptions::enhance, enhance_schema(/*with_enabled=*/false));
     s.moved_block("enhance");  // older configs: `enhance: {enhance: {rit: ...}}`
     s.upgrade(drop_enabled);
+  });
+}
+
+config::Schema<TrainOptions> elastic_stage_schema() {
+  return train_schema_with([](config::Schema<TrainOptions>& s) {
+    s.inline_section(&TrainOptions::elastic, elastic_training_schema(/*with_enabled=*/false));
   });
 }
 
@@ -100,7 +111,26 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
   spdlog::info("training {} on {} ({} train / {} val frames)", name, data.info().root.string(),
                data.frames(Split::Train).size(), data.frames(Split::Val).size());
 
-  Trainer trainer(network, data, options.schedule, options.loss);
+  TrainHooks hooks;
+  nlohmann::ordered_json extra = {{"name", name}, {"data", data.info().root.string()}};
+  std::optional<ElasticSpace> space;
+  if (options.elastic.enabled) {
+    if (options.distill.enabled())
+      throw Error("train: distill", "an elastic network distils from its own full network; remove 'distill'");
+    ElasticNetwork elastic = make_elastic(*network, options.elastic.space);
+    network = elastic.network;
+    space.emplace(elastic.space);
+    hooks = elastic_training_hooks(network, *space, options.elastic, options.loss, options.schedule.steps,
+                                   static_cast<uint64_t>(options.seed));
+    stage = "elastic";
+    spdlog::info("{}: elastic over {} layer groups and {} blocks (at least {})", name, space->genes().size(),
+                 space->total_blocks(), space->min_blocks());
+  } else if (options.distill.enabled()) {
+    Model teacher = load_model(options.distill.teacher);
+    hooks = distillation_hooks(teacher.network, options.distill.weight, options.loss.image_norm);
+    extra["teacher"] = options.distill.teacher;
+  }
+  Trainer trainer(network, data, options.schedule, options.loss, {}, hooks);
   std::unique_ptr<distributed::World> world;
   if (options.distributed.enabled()) {
     // What the training depends on, paths aside (they may differ between machines).
@@ -130,7 +160,17 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
   provenance.parent = source.kind == ModelSource::Kind::ModelFile ? options.model : "";
   provenance.config = yaml_to_json(resolved);
   provenance.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
-  provenance.extra = {{"name", name}, {"data", data.info().root.string()}};
+  if (space) {
+    const auto& lr = data.resolutions().front();
+    network->eval();
+    const LatencyTable table = measure_latency_table(*network, *space, lr.width, lr.height, options.elastic.latency);
+    spdlog::info("{}: latency table of {} convolution shapes at {}x{}; prediction error on {} subnets: mean {:.1f}%, "
+                 "max {:.1f}%", name, table.conv_ms.size(), lr.width, lr.height, table.error.subnets,
+                 table.error.mean_abs_percent, table.error.max_abs_percent);
+    extra["elastic"] = elastic_metadata(*space);
+    extra["latency_table"] = to_json(table);
+  }
+  provenance.extra = extra;
   save_model(run_dir.file("model.cgsr"), *network, provenance);
   trainer.save_last_model(run_dir.file("last.cgsr"), provenance);
 

@@ -1,8 +1,10 @@
 #pragma once
 // The train job: what `cgsr train` runs, and the train, enhance and control stages of `cgsr run`.
 // Trains a plain backbone, or turns a trained backbone into a CG-enhanced network (RIT +
-// geometry head, inherited weights) and trains that. Writes model.cgsr (best validation
-// weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
+// geometry head, inherited weights) and trains that; with `elastic`, trains the network as an
+// elastic network whose subnets all work and measures its latency table (the elastic stage);
+// with `distill`, learns a teacher's output beside the HR frame. Writes model.cgsr (best
+// validation weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +12,8 @@
 #include "distributed/world.h"
 #include "models/arch_spec.h"
 #include "pipeline/run_settings.h"
+#include "train/distillation.h"
+#include "train/elastic_training.h"
 #include "train/losses.h"
 #include "train/trainer.h"
 
@@ -27,6 +31,8 @@ struct TrainOptions : RunSettings {
   int scale = 2;
   std::string name;          // display name in reports (default: derived from the spec)
   EnhanceOptions enhance;
+  ElasticTrainingOptions elastic;  // train as an elastic network (train/elastic_training.h)
+  DistillOptions distill;          // learn a teacher's output too (train/distillation.h)
   TrainSchedule schedule;
   LossOptions loss;
   bool resume = false;       // continue from checkpoint.pt in --out
@@ -38,6 +44,9 @@ config::Schema<TrainOptions> train_schema();
 // sit at its top level, as the stage always enhances. It parses into TrainOptions, which emits
 // (and is recorded) as a `cgsr train` config.
 config::Schema<TrainOptions> enhance_stage_schema();
+// The elastic stage of `cgsr run`: a training config whose elastic block's keys (space, sampled,
+// distill, depth, width, latency) sit at its top level, as the stage always trains elastically.
+config::Schema<TrainOptions> elastic_stage_schema();
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
 
 }  // namespace cgsr

@@ -31,13 +31,30 @@ config::Schema<VerdictOptions> verdict_schema() {
           "test PSNR the hybrid model must gain over magnitude pruning at its mean MACs (may be negative)");
   s.field("min_patterns_used", &VerdictOptions::min_patterns_used, "distinct patterns chosen on the test frames")
       .at_least(0);
+  s.field("max_elastic_loss_db", &VerdictOptions::max_elastic_loss_db,
+          "test PSNR the elastic network's full subnet may lose against the CG-enhanced network")
+      .at_least(0);
+  s.field("min_search_evaluations", &VerdictOptions::min_search_evaluations, "subnets the search must score")
+      .at_least(0);
+  s.field("max_final_latency_fraction", &VerdictOptions::max_final_latency_fraction,
+          "latency of the CG-optimized network against the backbone's")
+      .at_least(0);
+  s.field("max_final_loss_db", &VerdictOptions::max_final_loss_db,
+          "test PSNR the CG-optimized network may lose against the backbone");
+  s.field("min_gain_over_scratch_db", &VerdictOptions::min_gain_over_scratch_db,
+          "PSNR the CG-optimized network must gain over its architecture trained from scratch (test and held-out)");
+  s.field("min_gain_over_controls_db", &VerdictOptions::min_gain_over_controls_db,
+          "PSNR the CG-optimized network must gain over every control about as fast");
+  s.field("latency_tolerance", &VerdictOptions::latency_tolerance,
+          "a control counts as fast as the CG-optimized network when at most this fraction slower")
+      .range(0, 1);
   s.field("fail_run", &VerdictOptions::fail_run, "exit with an error when a check fails");
   return s;
 }
 
 std::vector<const EvalResult*> PipelineResults::networks() const {
   std::vector<const EvalResult*> out;
-  for (const EvalResult* r : {backbone, control, cg_enhanced, cg_optimized, pruned})
+  for (const EvalResult* r : {backbone, control, cg_enhanced, elastic, cg_optimized, pruned})
     if (r) out.push_back(r);
   return out;
 }
@@ -123,6 +140,66 @@ void check_dynamic_pruning(Verdict& v, const EvalResult& hybrid, const EvalResul
                       used >= options.min_patterns_used, choices ? usage_text(*choices) : "no frame recorded a pattern"});
 }
 
+// The final network against the backbone, its architecture from scratch and the controls.
+void check_final_network(Verdict& v, const PipelineResults& r, const VerdictOptions& options) {
+  const EvalResult& final_network = *r.cg_optimized;
+  if (r.backbone) {
+    const std::string claim = fmt::format("{} runs at most {:g} of {}'s latency", final_network.name,
+                                          options.max_final_latency_fraction, r.backbone->name);
+    if (final_network.latency && r.backbone->latency) {
+      const double fraction = final_network.latency->median_ms / r.backbone->latency->median_ms;
+      v.checks.push_back({claim, fraction <= options.max_final_latency_fraction,
+                          fmt::format("{:.1f} ms against {:.1f} ms ({:.0f}%)", final_network.latency->median_ms,
+                                      r.backbone->latency->median_ms, 100 * fraction)});
+    } else {
+      v.checks.push_back({claim, false, "latency was not measured (eval.latency_runs is 0)"});
+    }
+    const double loss = r.backbone->psnr - final_network.psnr;
+    v.checks.push_back({fmt::format("{} loses at most {:g} dB against {}", final_network.name, options.max_final_loss_db,
+                                    r.backbone->name),
+                        loss <= options.max_final_loss_db,
+                        fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", final_network.psnr, r.backbone->psnr,
+                                    -loss)});
+  }
+  if (r.scratch)
+    check_gain(v, "overall", final_network, *r.scratch, final_network.psnr, r.scratch->psnr,
+               options.min_gain_over_scratch_db);
+  for (const auto& h : r.heldout)
+    if (h.cg_optimized && h.scratch)
+      check_gain(v, "on held-out scene '" + h.scene + "'", *h.cg_optimized, *h.scratch, h.cg_optimized->psnr,
+                 h.scratch->psnr, options.min_gain_over_scratch_db);
+  for (const EvalResult* c : r.controls) {
+    const std::string claim = fmt::format("{} beats {} by {:g} dB when that is as fast", final_network.name, c->name,
+                                          options.min_gain_over_controls_db);
+    if (!final_network.latency || !c->latency) {
+      v.checks.push_back({claim, false, "latency was not measured (eval.latency_runs is 0)"});
+      continue;
+    }
+    const double ratio = c->latency->median_ms / final_network.latency->median_ms;
+    const double gain = final_network.psnr - c->psnr;
+    const bool as_fast = ratio <= 1 + options.latency_tolerance;
+    v.checks.push_back({claim, !as_fast || gain >= options.min_gain_over_controls_db,
+                        fmt::format("{:+.3f} dB ({:.3f} against {:.3f} dB) at {:.2f}x its latency{}", gain,
+                                    final_network.psnr, c->psnr, ratio, as_fast ? "" : " (slower: no threat)")});
+  }
+}
+
+void check_search(Verdict& v, const std::vector<SearchRunStats>& searches, const VerdictOptions& options) {
+  if (searches.empty()) return;
+  const auto& s = searches.front();
+  v.checks.push_back({fmt::format("the search scores at least {} subnets", options.min_search_evaluations),
+                      s.evaluations >= options.min_search_evaluations,
+                      fmt::format("{}: {} subnets", s.strategy, s.evaluations)});
+  for (size_t i = 1; i < searches.size(); ++i) {
+    const auto& b = searches[i];
+    v.checks.push_back({fmt::format("{}'s front dominates {}'s at as many evaluations (hypervolume)", s.strategy,
+                                    b.strategy),
+                        s.hypervolume >= b.hypervolume && s.evaluations <= b.evaluations,
+                        fmt::format("{:.2f} against {:.2f} dB ms over {} and {} subnets", s.hypervolume, b.hypervolume,
+                                    s.evaluations, b.evaluations)});
+  }
+}
+
 void check_beats_bicubic(Verdict& v, const std::vector<const EvalResult*>& networks, const EvalResult& bicubic,
                          const std::string& where) {
   for (const EvalResult* n : networks)
@@ -142,7 +219,17 @@ Verdict judge_pipeline(const PipelineResults& r, const VerdictOptions& options) 
     check_gain(v, "on geometry edges", *r.cg_enhanced, *r.control, r.cg_enhanced->psnr_edge, r.control->psnr_edge,
                options.min_enhance_edge_gain_db);
   }
+  if (r.cg_enhanced && r.elastic) {
+    const double loss = r.cg_enhanced->psnr - r.elastic->psnr;
+    v.checks.push_back({fmt::format("{} loses at most {:g} dB against {}", r.elastic->name, options.max_elastic_loss_db,
+                                    r.cg_enhanced->name),
+                        loss <= options.max_elastic_loss_db,
+                        fmt::format("{:.3f} dB against {:.3f} dB ({:+.3f} dB)", r.elastic->psnr, r.cg_enhanced->psnr,
+                                    -loss)});
+  }
   if (r.cg_enhanced && r.cg_optimized) check_cuts(v, "search", *r.cg_enhanced, *r.cg_optimized, options.max_search_loss_db);
+  check_search(v, r.searches, options);
+  if (r.cg_optimized) check_final_network(v, r, options);
   if (r.cg_optimized && r.pruned) check_cuts(v, "pruning", *r.cg_optimized, *r.pruned, options.max_prune_loss_db);
   if (r.pruned && r.pruned_static) check_dynamic_pruning(v, *r.pruned, *r.pruned_static, r.magnitude, options);
   for (const auto& h : r.heldout) {

@@ -5,8 +5,16 @@
 //   - the CG-enhanced network beats the plain backbone trained on for the same steps (the
 //     control: what the extra training alone gives) by `min_enhance_gain_db` overall and by
 //     `min_enhance_edge_gain_db` on geometry-edge pixels, where rendering information should help;
+//   - the elastic network's full subnet loses at most `max_elastic_loss_db` against the
+//     CG-enhanced network it was trained from;
 //   - the search cuts params, MACs and latency of the CG-enhanced network, losing at most
-//     `max_search_loss_db` PSNR;
+//     `max_search_loss_db` PSNR; it scored at least `min_search_evaluations` subnets, and
+//     evolution's front has at least the hypervolume of random search's at as many evaluations;
+//   - the CG-optimized network (the final network) runs at most `max_final_latency_fraction` of
+//     the backbone's latency and loses at most `max_final_loss_db` against it; it beats its own
+//     architecture trained from scratch as long by `min_gain_over_scratch_db`, on the test frames
+//     and on every held-out scene; and no control of equal latency (a control at most
+//     `latency_tolerance` slower) comes within `min_gain_over_controls_db` of it;
 //   - pruning cuts params, MACs and latency of the searched network, losing at most
 //     `max_prune_loss_db` PSNR;
 //   - the dynamic part pays: the hybrid model's mean latency per frame (over the test frames in
@@ -29,6 +37,13 @@ namespace cgsr {
 
 struct VerdictOptions {
   double max_search_loss_db = 0.3;  // PSNR the CG-optimized network may lose against its parent
+  double max_elastic_loss_db = 0.05;        // the elastic network's full subnet against the CG-enhanced one
+  int min_search_evaluations = 1000;        // subnets the search scored
+  double max_final_latency_fraction = 0.35; // CG-optimized latency against the backbone's
+  double max_final_loss_db = 0.1;           // CG-optimized PSNR below the backbone's
+  double min_gain_over_scratch_db = 0.1;    // against its architecture trained from scratch
+  double min_gain_over_controls_db = 0.05;  // against every control about as fast
+  double latency_tolerance = 0.05;          // "as fast": at most this fraction slower
   double max_prune_loss_db = 0.3;   // PSNR the pruned network may lose against its input
   double min_enhance_gain_db = 0;       // PSNR the CG-enhanced network must gain over the control
   double min_enhance_edge_gain_db = 0;  // the same on geometry-edge pixels
@@ -45,6 +60,15 @@ struct HeldoutScene {
   std::string scene;
   const EvalResult* bicubic = nullptr;
   std::vector<const EvalResult*> networks;
+  const EvalResult* cg_optimized = nullptr;
+  const EvalResult* scratch = nullptr;
+};
+
+// What a search run reports: its strategy, subnets scored and its front's hypervolume.
+struct SearchRunStats {
+  std::string strategy;
+  int evaluations = 0;
+  double hypervolume = 0;
 };
 
 // The evaluations a verdict needs, by role; a role left null is not checked.
@@ -57,6 +81,10 @@ struct PipelineResults {
   const EvalResult* pruned = nullptr;        // hybrid-pruned CG-optimized network
   const EvalResult* pruned_static = nullptr;  // the hybrid model's static network alone
   const EvalResult* magnitude = nullptr;     // magnitude pruning at the hybrid's mean MACs
+  const EvalResult* elastic = nullptr;       // the elastic network's full subnet
+  const EvalResult* scratch = nullptr;       // the CG-optimized architecture trained from scratch
+  std::vector<const EvalResult*> controls;   // cut to the CG-optimized network's latency
+  std::vector<SearchRunStats> searches;      // the search, then its baseline
   std::vector<HeldoutScene> heldout;
   std::vector<const EvalResult*> networks() const;  // every non-null learned model
 };

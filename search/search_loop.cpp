@@ -87,7 +87,9 @@ SearchResult run_search(const ElasticSpace& space, Evaluator& evaluator, SearchH
   const auto seen = [&](const std::string& key) { return evaluated_keys.count(key) > 0; };
   const std::string purpose = "search-" + stream;
   for (int generation = 0; generation < options.generations; ++generation) {
-    auto rng = make_rng(purpose.c_str(), static_cast<uint64_t>(generation));
+    // Every strategy's first generation is drawn from one stream: with one seed, evolution and
+    // random search start from the same subnets.
+    auto rng = generation == 0 ? make_rng("search-first-generation") : make_rng(purpose.c_str(), generation);
     const auto proposals = strategy->propose(population, options.population, seen, rng);
     if (proposals.size() < 2) {
       result.stop_reason = "only " + std::to_string(proposals.size()) + " unseen subnet(s) left in generation " +
@@ -156,9 +158,9 @@ std::vector<Candidate> latency_front(const std::vector<Candidate>& candidates) {
     quality.push_back(c.quality);
   }
   std::vector<Candidate> front;
-  std::set<std::string> keys;
+  std::set<std::pair<double, double>> points;  // subnets that score alike count once
   for (size_t i : pareto_front(cost, quality))
-    if (keys.insert(alive[i].key).second) front.push_back(alive[i]);
+    if (points.insert({cost[i], quality[i]}).second) front.push_back(alive[i]);
   std::stable_sort(front.begin(), front.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score.latency_ms < b.score.latency_ms; });
   return front;

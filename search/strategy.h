@@ -5,7 +5,7 @@
 //   evolution  NSGA-II: parents by binary tournament on Pareto rank and crowding, uniform
 //              crossover, then per-gene mutation (the CGSR search, multi-objective)
 //   random     subnets drawn uniformly from the space (the baseline at equal evaluations)
-// Both start from the same first generation: uniform samples of the space.
+// Both start from the same first generation (search_loop.h): uniform samples of the space.
 
 #include <functional>
 #include <memory>

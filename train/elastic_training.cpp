@@ -25,9 +25,11 @@ double opened(const ShrinkPhase& phase, double progress) {
 }
 }  // namespace
 
-config::Schema<ElasticTrainingOptions> elastic_training_schema() {
+config::Schema<ElasticTrainingOptions> elastic_training_schema(bool with_enabled) {
   config::Schema<ElasticTrainingOptions> s;
-  s.field("enabled", &ElasticTrainingOptions::enabled, "train the network as an elastic network (sorted channels, sandwich rule)");
+  if (with_enabled)
+    s.field("enabled", &ElasticTrainingOptions::enabled,
+            "train the network as an elastic network (sorted channels, sandwich rule)");
   s.section("space", &ElasticTrainingOptions::space, elastic_options_schema(), "the subnets the network must hold");
   s.field("sampled", &ElasticTrainingOptions::sampled, "random subnets per step besides the full one and the smallest")
       .range(0, 16);

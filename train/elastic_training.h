@@ -39,7 +39,8 @@ struct ElasticTrainingOptions {
   ShrinkPhase width{0.25, 0.25};
   LatencyTableOptions latency;  // the latency table measured after training, stored with the model
 };
-config::Schema<ElasticTrainingOptions> elastic_training_schema();
+// `with_enabled`: the `enabled` key (a stage that always trains elastically leaves it out).
+config::Schema<ElasticTrainingOptions> elastic_training_schema(bool with_enabled = true);
 
 // How far subnets may shrink at `step` of `steps`.
 ShrinkLimits shrink_limits(const ElasticTrainingOptions& options, int step, int steps);

@@ -13,7 +13,8 @@
 #include "export/verification.h"
 #include "models/inherit.h"
 #include "pruning/baseline_pruning.h"
-#include "search/search_space.h"
+#include "models/elastic.h"
+#include "models/subnet.h"
 #include "tests/export/export_cases.h"
 #include "tests/support/cli_runner.h"
 
@@ -61,17 +62,18 @@ TEST(Verification, EveryNetworkMatchesOurForwardInEveryRuntime) {
   std::filesystem::remove_all(dir);
 }
 
-// What the search and pruning stages produce are plain specs with smaller, uneven widths and
-// inherited weights: they export and verify like any network.
+// What the search and pruning stages produce are plain specs with smaller, uneven widths, fewer
+// blocks and inherited weights: a subnet of an elastic network and a magnitude-pruned network
+// export and verify like any network.
 TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
   const auto dir = test::scratch_dir("export-verify-searched-pruned");
   SRNetwork parent = test::build_network(test::with_rit(default_spec("pan", 2), "lr", "concat"), 500);
-  const SearchSpace space(parent->spec(), SearchSpaceOptions());
+  const ElasticSpace space(parent->spec(), ElasticOptions{});
   std::mt19937_64 rng(5);
-  ArchSpec searched = space.sample(rng);
-  while (searched == parent->spec()) searched = space.sample(rng);
+  SubnetConfig searched = space.sample(rng);
+  while (searched.blocks.size() == static_cast<size_t>(space.total_blocks())) searched = space.sample(rng);
   const std::vector<std::pair<std::string, SRNetwork>> nets = {
-      {"searched", inherit(*parent, searched).network},
+      {"searched", materialize_subnet(*parent, searched)},
       {"magnitude_pruned", magnitude_prune(*parent, 0.5).network},
   };
   std::vector<VerifyCase> cases;

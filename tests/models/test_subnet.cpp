@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "models/elastic.h"
+#include "models/importance/channel_importance.h"
 #include "models/subnet.h"
 #include "tests/models/model_cases.h"
 
@@ -206,7 +207,7 @@ TEST(ElasticSpace, MakeElasticSortsChannelsAndKeepsTheOutput) {
   const auto [color, info] = test::random_inputs(spec, 8, 8);
   torch::NoGradGuard no_grad;
   EXPECT_LT((elastic.network->forward(color, info) - net->forward(color, info)).abs().max().item<double>(), 1e-5);
-  for (const auto& [group, scores] : elastic.network->channel_importance()) {
+  for (const auto& [group, scores] : channel_importance(*elastic.network)) {
     const auto s = scores.detach();
     for (int64_t i = 0; i + 1 < s.numel(); ++i) EXPECT_GE(s[i].item<double>(), s[i + 1].item<double>()) << group;
   }

@@ -28,16 +28,20 @@ enhance:
   rit: {channels: [depth, normal_angle, edge], width: 8, hr_width: 8, source: hr_unshuffle+hr_fuse}
   geometry: {enabled: true, width: 8}
   schedule: {steps: 4, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+elastic:
+  space: {quantum: 4, min_width_fraction: 0.5, min_blocks: 2}
+  sampled: 1
+  schedule: {steps: 4, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+  latency: {runs: 1, calibration_subnets: 2, check_subnets: 1, subnet_runs: 1}
 search:
   name: CG-optimized PAN x2
-  population: 2
-  selection_ratio: 0.5
-  generations: 1
-  min_candidates: 1
-  tolerance_db: 100
-  candidate:
+  population: 4
+  generations: 2
+  crops: {frames: 1, crops_per_frame: 2, size: 12, margin: 2}
+  pick: {latency_fraction: 0.6}
+  final:
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
-  final: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
+scratch: {steps: 3}
 prune:
   pool_frames: 2
   pool: {keep_rates: [1.0, 0.5]}
@@ -48,7 +52,7 @@ prune:
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 eval: {max_frames: 2, latency_runs: 1}
 heldout: {scenes: [HELDOUT], frames: 2}
-verdict: {fail_run: false}
+verdict: {fail_run: false, min_search_evaluations: 8}
 )";
 
 // A scene the networks never train on: another room of the tiny scene's kind.
@@ -84,7 +88,8 @@ fs::path write_config(const fs::path& dir) {
 std::map<std::string, std::string> stage_actions(const std::string& log) {
   std::map<std::string, std::string> out;
   for (const std::string stage :
-       {"render", "train", "enhance", "control", "search", "prune", "export", "eval", "heldout", "report"}) {
+       {"render", "train", "enhance", "control", "elastic", "search", "prune", "scratch", "controls", "export", "eval",
+        "heldout", "report"}) {
     if (log.find("] " + stage + ": up to date") != std::string::npos)
       out[stage] = "skipped";
     else if (log.find("] " + stage + ": done in") != std::string::npos)
@@ -113,11 +118,14 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   const CliResult first = run_cgsr(args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   for (const auto& [stage, action] : stage_actions(first.err)) EXPECT_EQ(action, "ran") << stage;
-  EXPECT_EQ(stage_actions(first.err).size(), 10u) << first.err;
-  for (const std::string stage :
-       {"data", "train", "enhance", "control", "search", "prune", "export", "eval", "heldout", "report"})
+  EXPECT_EQ(stage_actions(first.err).size(), 13u) << first.err;
+  for (const std::string stage : {"data", "train", "enhance", "control", "elastic", "search", "prune", "scratch",
+                                  "controls", "export", "eval", "heldout", "report"})
     EXPECT_TRUE(read_json(out / stage / "stage.json")["done"].get<bool>()) << stage;
-  for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "control/model.cgsr", "search/model.cgsr", "prune/pruned.cgsr",
+  for (const std::string file : {"train/model.cgsr", "enhance/model.cgsr", "control/model.cgsr", "elastic/model.cgsr",
+                                 "search/model.cgsr", "search/history.jsonl", "search/random_history.jsonl",
+                                 "search/front.png", "scratch/model.cgsr", "controls/magnitude.cgsr",
+                                 "controls/uniform.cgsr", "prune/pruned.cgsr",
                                  "export/cg_optimized.onnx", "export/pruned/pattern_0.onnx", "export/pruned/selector.onnx",
                                  "export/pruned/manifest.json", "export/pruned_torchscript/pattern_0.pt",
                                  "heldout/1_heldout/data/manifest.yaml", "heldout/1_heldout/eval/results.json",
@@ -126,8 +134,10 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
 
   // The report holds every model of the pipeline; the verdict judges them.
   const std::string report = slurp(out / "report" / "report.md");
-  for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2", "CG-optimized PAN x2",
-                                "CG-optimized PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
+  for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2",
+                                "elastic CG-enhanced PAN x2", "CG-optimized PAN x2", "CG-optimized PAN x2 (scratch)",
+                                "CG-enhanced PAN x2 MMP", "CG-enhanced PAN x2 uniform width", "CG-optimized PAN x2 MMP",
+                                "CG-optimized PAN x2 hybrid"})
     EXPECT_NE(report.find("| " + row + " "), std::string::npos) << row << "\n" << report;
   const auto results = read_json(out / "results.json");
   EXPECT_GE(results["verdict"]["checks"].size(), 15u);
@@ -146,13 +156,13 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   int heldout_checks = 0;
   for (const auto& check : results["verdict"]["checks"])
     heldout_checks += check["claim"].get<std::string>().find("on held-out scene 'tiny-heldout'") != std::string::npos;
-  EXPECT_EQ(heldout_checks, 5);  // PAN, its control, CG-enhanced, CG-optimized, the hybrid
+  EXPECT_EQ(heldout_checks, 6);  // PAN, its control, CG-enhanced, CG-optimized, the hybrid; against scratch
 
   // A rerun finds every stage finished.
   const CliResult again = run_cgsr(args);
   ASSERT_EQ(again.exit_code, 0) << again.err;
   for (const auto& [stage, action] : stage_actions(again.err)) EXPECT_EQ(action, "skipped") << stage;
-  EXPECT_EQ(stage_actions(again.err).size(), 10u);
+  EXPECT_EQ(stage_actions(again.err).size(), 13u);
   EXPECT_NE(again.out.find("verdict:"), std::string::npos);  // still printed
 
   // --from eval reruns eval, heldout and report only.
@@ -166,11 +176,12 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   EXPECT_NE(same.err.find(tiny), std::string::npos) << same.err;
   EXPECT_NE(same.err.find("as the training data is"), std::string::npos) << same.err;
 
-  // A changed search config reruns search and what depends on it, not the trainings before it,
-  // nor eval (which reads neither search nor prune).
-  expect_actions(run_cgsr(args + " --set search.final.steps=3"),
-                 {{"train", "skipped"}, {"enhance", "skipped"}, {"control", "skipped"}, {"search", "ran"}, {"prune", "ran"},
-                  {"eval", "skipped"}, {"heldout", "ran"}, {"report", "ran"}});
+  // A changed search config reruns search and what depends on it (scratch trains as many steps
+  // as the search's fine-tuning adds), not the trainings before it.
+  expect_actions(run_cgsr(args + " --set search.final.schedule.steps=3"),
+                 {{"train", "skipped"}, {"enhance", "skipped"}, {"control", "skipped"}, {"elastic", "skipped"},
+                  {"search", "ran"}, {"prune", "ran"}, {"scratch", "ran"}, {"controls", "ran"}, {"eval", "ran"},
+                  {"heldout", "ran"}, {"report", "ran"}});
   fs::remove_all(dir);
 }
 
@@ -189,9 +200,9 @@ TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   EXPECT_NE(late.err.find("prune.pool.keep_rates: must be strictly decreasing"), std::string::npos) << late.err;
   EXPECT_FALSE(fs::exists(dir / "run" / "data" / "manifest.yaml"));
 
-  const CliResult filled = run_cgsr(base + " --set search.parent=x.cgsr");
+  const CliResult filled = run_cgsr(base + " --set search.model=x.cgsr");
   EXPECT_EQ(filled.exit_code, 2);
-  EXPECT_NE(filled.err.find("search.parent: is filled in by cgsr run"), std::string::npos) << filled.err;
+  EXPECT_NE(filled.err.find("search.model: is filled in by cgsr run"), std::string::npos) << filled.err;
 
   const CliResult both = run_cgsr(base + " --set data=somewhere");
   EXPECT_EQ(both.exit_code, 2);

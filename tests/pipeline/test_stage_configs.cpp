@@ -22,30 +22,27 @@ std::vector<std::string> keys_of(const YAML::Node& map) {
 }
 }  // namespace
 
-TEST(StageConfigs, SearchOptionsSitAtTheTopAndTheFormerSearchBlockReadsTheSame) {
-  const auto flat = parse<SearchCommandOptions>(
-      "parent: p.cgsr\ndata: d\nstrategy: {type: evolution, mutation_rate: 0.25}\npopulation: 4\nfinal: {steps: 3}\n",
+TEST(StageConfigs, SearchOptionsSitAtTheTopWithTheStrategyInItsOwnBlock) {
+  const auto o = parse<SearchCommandOptions>(
+      "model: e.cgsr\ndata: d\nstrategy: {type: evolution, mutation_rate: 0.25}\npopulation: 4\n"
+      "on_failure: {score: retry}\nfinal: {schedule: {steps: 3}}\n",
       search_command_schema());
-  const auto nested = parse<SearchCommandOptions>(
-      "parent: p.cgsr\ndata: d\nsearch:\n  strategy: evolution\n  population: 4\n  operators: {mutation_rate: 0.25}\n"
-      "final: {steps: 3}\n",
-      search_command_schema());
-  const YAML::Node emitted = search_command_schema().emit(flat);
-  EXPECT_EQ(config::to_yaml(emitted), config::to_yaml(search_command_schema().emit(nested)));
-  EXPECT_EQ(flat.search.population, 4);
-  EXPECT_DOUBLE_EQ(flat.search.strategy.evolution.mutation_rate, 0.25);
+  EXPECT_EQ(o.search.population, 4);
+  EXPECT_DOUBLE_EQ(o.search.strategy.evolution.mutation_rate, 0.25);
+  EXPECT_EQ(o.search.on_failure.score, FailurePolicy::Retry);
+  EXPECT_EQ(o.final.schedule.steps, 3);
+  EXPECT_EQ(o.baseline, "random");
+  EXPECT_THROW(parse<SearchCommandOptions>("model: e\ndata: d\nbaseline: nope\n", search_command_schema()), Error);
+  EXPECT_THROW(parse<SearchCommandOptions>("model: e\ndata: d\non_failure: {score: sometimes}\n",
+                                           search_command_schema()),
+               Error);
+}
 
-  // The cache form is the former shape, key for key (what `cgsr search` emitted before), once
-  // `cgsr run` leaves out the distributed block, which no stage hash includes.
-  const YAML::Node cached = without_distribution(search_config_cache_form(emitted));
-  EXPECT_EQ(keys_of(cached), (std::vector<std::string>{"parent", "data", "search", "candidate", "final", "name",
-                                                        "resume", "seed", "threads"}));
-  EXPECT_EQ(keys_of(cached["search"]),
-            (std::vector<std::string>{"strategy", "population", "selection_ratio", "generations", "min_candidates",
-                                      "tolerance_db", "space", "operators", "fitness"}));
-  EXPECT_EQ(cached["search"]["strategy"].Scalar(), "evolution");
-  EXPECT_EQ(config::to_yaml(cached["search"]["operators"]),
-            "initial_spread: 0.5\nmutation_rate: 0.25\ncrossover_rate: 0.5\n");
+TEST(StageConfigs, TheElasticStageTakesItsElasticKeysAtItsTop) {
+  const auto flat = parse<TrainOptions>("data: d\nsampled: 3\nspace: {quantum: 8}\n", elastic_stage_schema());
+  EXPECT_EQ(flat.elastic.sampled, 3);
+  EXPECT_EQ(flat.elastic.space.quantum, 8);
+  EXPECT_THROW(parse<TrainOptions>("data: d\nenabled: true\n", elastic_stage_schema()), Error);
 }
 
 TEST(StageConfigs, TheEnhanceStageTakesRitAndGeometryAtItsTop) {

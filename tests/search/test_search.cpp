@@ -1,292 +1,247 @@
-// The search: its space and operators on real specs, and the generation loop, the pick rule and
-// resume, driven through the Evaluator interface by a deterministic scoring of specs.
+// The subnet search: genetic operators inside an elastic space, the Pareto tools, the generation
+// loop with resume and failure policies (driven through the Evaluator interface by a scoring of
+// each subnet from its real graph), and the inference evaluator on a rendered scene.
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
+#include <random>
 #include <set>
 
 #include "core/error.h"
+#include "core/pareto.h"
 #include "core/runtime.h"
 #include "models/backbone_registry.h"
-#include "models/sr_network.h"
+#include "models/complexity.h"
+#include "models/elastic.h"
+#include "search/genetic_operators.h"
 #include "search/search_loop.h"
-#include "tests/support/cli_runner.h"
+#include "search/subnet_evaluator.h"
+#include "tests/support/tiny_data.h"
 
 using namespace cgsr;
 
 namespace {
-ArchSpec enhanced_pan(int blocks = 4) {
+ArchSpec elastic_pan(int blocks = 4) {
   ArchSpec spec;
   spec.backbone = "pan";
   spec.scale = 2;
   spec.blocks = blocks;
   spec.rit.enabled = true;
-  spec.geometry.enabled = true;
+  spec.rit.source = RitSource::HrUnshuffleHrFuse;
   return resolve_spec(spec);
 }
 
-// Scores a spec from its real parameter count: quality falls off as the network shrinks, and
-// RIT channels help (depth and edge most). Deterministic, like the real evaluator must be.
+std::filesystem::path temp_file(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cgsr_test_search_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::filesystem::remove(path);
+  return path;
+}
+
+// Scores a subnet from its real graph: latency is its MAC count, and quality rises with the log of
+// each layer group's width, weighted by how much that group matters (some much more than others,
+// as in a real network), and a little with depth. Deterministic, like the real evaluator must be.
+// `diverging` keys fail to score (a non-finite output).
 class ScoringEvaluator : public Evaluator {
  public:
-  explicit ScoringEvaluator(ArchSpec parent, int fail_after = -1) : parent_(std::move(parent)), fail_after_(fail_after) {}
-  CandidateScore evaluate(const ArchSpec& spec) override {
-    if (fail_after_ >= 0 && calls_ >= fail_after_) throw Error("evaluator", "killed");
+  explicit ScoringEvaluator(const ArchSpec& spec) : net_(spec) {}
+  SubnetScore evaluate(const SubnetConfig& sub) override {
     ++calls_;
-    return score(spec);
-  }
-  CandidateScore evaluate_parent() override { return score(parent_); }
-  int calls() const { return calls_; }
-
- private:
-  CandidateScore score(const ArchSpec& spec) const {
-    const double params = static_cast<double>(inference_parameter_count(*SRNetwork(spec)));
-    const double parent_params = static_cast<double>(inference_parameter_count(*SRNetwork(parent_)));
-    const double shrink = 1.0 - params / parent_params;
-    double bonus = 0;
-    for (const auto& c : spec.rit.channels) bonus += c == "depth" || c == "edge" ? 0.05 : 0.01;
-    CandidateScore s;
-    s.params = static_cast<int64_t>(params);
-    s.macs = s.params * 1000;
-    s.val_psnr = 33.0 + bonus - 3.0 * std::pow(std::max(0.0, shrink - 0.3), 2);
-    s.image_loss = std::pow(10.0, -s.val_psnr / 10.0);
-    s.geometry_loss = 0.01 * (1 + shrink);
+    if (diverging.count(subnet_key(sub))) throw Error("subnet " + subnet_key(sub), "its output is not finite");
+    const Complexity c = complexity(subnet_graph(*net_, sub), 32, 24);
+    SubnetScore s;
+    s.macs = c.macs;
+    s.params = c.params;
+    s.latency_ms = static_cast<double>(c.macs) * 1e-6;
+    s.psnr = 30 + 0.05 * static_cast<double>(sub.blocks.size());
+    for (const auto& [group, width] : sub.widths) {
+      const auto block = parse_block_group(group);
+      if (block && !std::binary_search(sub.blocks.begin(), sub.blocks.end(), block->first)) continue;
+      const double weight = static_cast<double>(std::hash<std::string>{}(group) % 100) / 100.0;
+      s.psnr += weight * weight * std::log(static_cast<double>(width));
+    }
     return s;
   }
-  ArchSpec parent_;
-  int fail_after_;
+  int calls() const { return calls_; }
+  std::set<std::string> diverging;
+
+ private:
+  SRNetwork net_;
   int calls_ = 0;
 };
 
-SearchOptions small_search() {
+SearchOptions small_search(const std::string& strategy = "evolution") {
   SearchOptions o;
-  o.population = 6;
-  o.selection_ratio = 0.5;
-  o.generations = 3;
-  o.tolerance_db = 0.05;
+  o.strategy.type = strategy;
+  o.population = 12;
+  o.generations = 5;
   return o;
 }
-
-std::filesystem::path history_path(const std::string& name) {
-  return cgsr::test::scratch_dir("search-" + name) / "history.jsonl";
-}
 }  // namespace
 
-TEST(SearchSpace, WidthChoicesAreQuantizedAndKeepTheParentWidth) {
-  const SearchSpace space(enhanced_pan(), {});
-  EXPECT_EQ(space.width_choices(40), (std::vector<int>{16, 24, 32, 40}));
-  EXPECT_EQ(space.width_choices(20), (std::vector<int>{8, 16, 20}));
-  EXPECT_EQ(space.width_choices(24), (std::vector<int>{8, 16, 24}));
-}
-
-TEST(SearchSpace, OperatorsStayInsideTheSpace) {
-  seed_everything(3);
-  const SearchSpace space(enhanced_pan(), {});
-  auto rng = make_rng("test");
-  ArchSpec a = space.parent(), b = space.parent();
-  for (int i = 0; i < 30; ++i) {
-    a = space.mutate(a, 0.3, rng);
-    b = space.sample(rng);
-    const ArchSpec c = space.crossover(a, b, rng);
-    for (const ArchSpec* s : std::vector<const ArchSpec*>{&a, &b, &c}) {
-      ASSERT_TRUE(space.contains(*s)) << spec_to_yaml(*s);
-      EXPECT_LE(s->blocks, space.parent().blocks);
-      EXPECT_FALSE(s->rit.channels.empty());
-    }
-  }
-  EXPECT_NE(SearchSpace::key(a), SearchSpace::key(space.parent()));
-}
-
-TEST(SearchSpace, RejectsWiderThanTheParent) {
-  const SearchSpace space(enhanced_pan(), {});
-  ArchSpec wide = space.parent();
-  wide.widths.set("features", 48);
-  EXPECT_FALSE(space.contains(wide));
-}
-
-// Parent blocks 1 and 3 matter least: shallower candidates keep the others, and each block gene
-// stays with the parent block it belongs to through mutation, crossover and sampling.
-TEST(SearchSpace, ShallowerCandidatesDropBlocksInTheGivenOrder) {
-  const std::vector<int> order = {1, 3, 0, 2};
-  const SearchSpace space(enhanced_pan(4), {}, order);
-  const SearchSpace trailing(enhanced_pan(4), {});
-  ArchSpec three = space.parent();
-  three.blocks = 3;
-  three.widths = GroupWidths();
-  three = resolve_spec(three);
-  EXPECT_EQ(space.parent_blocks(three), (std::vector<int>{0, 2, 3}));
-  EXPECT_EQ(trailing.parent_blocks(three), (std::vector<int>{0, 1, 2}));
-  three.blocks = 2;
-  three.widths = GroupWidths();
-  EXPECT_EQ(space.parent_blocks(resolve_spec(three)), (std::vector<int>{0, 2}));
-
-  // Crossing a 4-block spec whose parent block 2 is narrowed with a 3-block one: a 3-block child
-  // carries the narrow gene on its block 1 (parent block 2), never on its block 2 (parent block 3).
-  ArchSpec marked = space.parent();
-  marked.widths.set(block_group(2, "a"), 8);
-  three.blocks = 3;
-  three.widths = GroupWidths();
-  three = resolve_spec(three);
-  ASSERT_TRUE(space.contains(marked));
-  ASSERT_TRUE(space.contains(three));
-  auto rng = make_rng("block-genes");
-  int carried = 0;
-  for (int i = 0; i < 100; ++i) {
-    const ArchSpec child = space.crossover(marked, three, rng);
-    ASSERT_TRUE(space.contains(child)) << spec_to_yaml(child);
-    const int on_parent_block_2 = child.blocks == 3 ? 1 : 2;
-    for (int b = 0; b < child.blocks; ++b) {
-      const int width = child.widths.at(block_group(b, "a"));
-      if (b == on_parent_block_2) carried += width == 8;
-      else EXPECT_EQ(width, 20) << "child block " << b << " of " << child.blocks;
-    }
-  }
-  EXPECT_GT(carried, 0);
-}
-
-TEST(SearchLoop, PicksTheSmallestCandidateWithinTolerance) {
-  Candidate parent;
-  parent.score.val_psnr = 33.0;
-  parent.score.params = 1000;
-  std::vector<Candidate> cands(3);
-  cands[0].score = {32.99, 0, 0, 0, 600, 0, {}, 0};  // within 0.05 dB
-  cands[1].score = {32.90, 0, 0, 0, 300, 0, {}, 0};  // smaller but too lossy
-  cands[2].score = {33.10, 0, 0, 0, 800, 0, {}, 0};
-  SearchOptions o;
-  bool is_parent = true;
-  EXPECT_EQ(pick_candidate(parent, cands, o, &is_parent).score.params, 600);
-  EXPECT_FALSE(is_parent);
-  o.tolerance_db = 0.0;
-  EXPECT_EQ(pick_candidate(parent, cands, o, &is_parent).score.params, 800);
-  cands[2].score.val_psnr = 32.0;
-  EXPECT_EQ(pick_candidate(parent, cands, o, &is_parent).score.params, 1000);
-  EXPECT_TRUE(is_parent);
-}
-
-TEST(SearchLoop, ParetoFrontKeepsWhatNothingBeatsOnSizeAndQuality) {
-  std::vector<Candidate> cands(5);
-  cands[0].score = {32.0, 0, 0, 0, 300, 0, {}, 0};
-  cands[1].score = {31.5, 0, 0, 0, 400, 0, {}, 0};  // bigger and worse than [0]
-  cands[2].score = {33.0, 0, 0, 0, 800, 0, {}, 0};
-  cands[3].score = {32.5, 0, 0, 0, 600, 0, {}, 0};
-  cands[4].score = {32.2, 0, 0, 0, 300, 0, {}, 0};  // same size as [0], better
-  const auto front = pareto_front(cands);
-  ASSERT_EQ(front.size(), 3u);
-  EXPECT_EQ(front[0].score.val_psnr, 32.2);
-  EXPECT_EQ(front[1].score.params, 600);
-  EXPECT_EQ(front[2].score.params, 800);
-  EXPECT_TRUE(pareto_front({}).empty());
-}
-
-TEST(SearchLoop, EvolutionShrinksTheNetworkAndNeverRetrains) {
-  seed_everything(11);
-  ScoringEvaluator evaluator(enhanced_pan());
-  SearchHistory history(history_path("evolution"), false);
-  const auto result = run_search(enhanced_pan(), evaluator, history, small_search());
-  EXPECT_FALSE(result.pick_is_parent);
-  EXPECT_LT(result.pick.score.params, result.parent.score.params);
-  EXPECT_GE(result.pick.score.val_psnr, result.parent.score.val_psnr - 0.05);
-  EXPECT_EQ(evaluator.calls(), static_cast<int>(result.evaluated.size()));
+TEST(GeneticOperators, StayInsideTheSpace) {
+  const ElasticSpace space(elastic_pan(), ElasticOptions{4, 0.25, 2});
+  std::mt19937_64 rng(3);
   std::set<std::string> keys;
-  for (const auto& c : result.evaluated) EXPECT_TRUE(keys.insert(c.key).second) << "trained twice";
-}
-
-TEST(SearchLoop, AResumedSearchReachesTheSamePick) {
-  seed_everything(5);
-  ScoringEvaluator full(enhanced_pan());
-  SearchHistory full_history(history_path("full"), false);
-  const auto uninterrupted = run_search(enhanced_pan(), full, full_history, small_search());
-
-  const auto path = history_path("killed");
-  seed_everything(5);
-  ScoringEvaluator killed(enhanced_pan(), /*fail_after=*/7);
-  {
-    SearchHistory history(path, false);
-    EXPECT_THROW(run_search(enhanced_pan(), killed, history, small_search()), Error);
+  for (int i = 0; i < 200; ++i) {
+    const SubnetConfig a = space.sample(rng), b = space.sample(rng);
+    const SubnetConfig m = mutate(space, a, 0.3, rng), c = crossover(space, a, b, rng);
+    EXPECT_TRUE(space.contains(m)) << subnet_key(m);
+    EXPECT_TRUE(space.contains(c)) << subnet_key(c);
+    keys.insert(subnet_key(m));
   }
-  // A kill may also cut the last line short.
-  { std::ofstream(path, std::ios::app) << "{\"generation\": 1, \"key\": \"trunc"; }
-  EXPECT_THROW(SearchHistory(path, false), Error);  // never overwritten without --resume
-  seed_everything(5);
-  ScoringEvaluator resumed(enhanced_pan());
-  SearchHistory history(path, true);
-  EXPECT_EQ(history.dropped_lines(), 1);
-  const auto result = run_search(enhanced_pan(), resumed, history, small_search());
-  EXPECT_EQ(result.pick.key, uninterrupted.pick.key);
-  EXPECT_EQ(resumed.calls() + 7, full.calls());  // only what was missing was evaluated
+  EXPECT_GT(keys.size(), 150u);  // mutation explores
+  // A rate of 0 changes nothing; crossover of a subnet with itself gives it back.
+  const SubnetConfig a = space.sample(rng);
+  EXPECT_EQ(subnet_key(mutate(space, a, 0.0, rng)), subnet_key(a));
+  EXPECT_EQ(subnet_key(crossover(space, a, a, rng)), subnet_key(a));
 }
 
-TEST(SearchLoop, RandomStrategyRunsThroughTheSameLoop) {
+TEST(Pareto, RanksCrowdingAndHypervolume) {
+  // cost, quality: 0 and 1 on the front, 2 behind 0, 3 behind everything.
+  const std::vector<double> cost = {1, 2, 1.5, 3}, quality = {1, 2, 0.5, 0};
+  EXPECT_EQ(pareto_ranks(cost, quality), (std::vector<int>{0, 0, 1, 2}));
+  EXPECT_EQ(pareto_front(cost, quality), (std::vector<size_t>{0, 1}));
+  const auto d = crowding_distance({0, 1}, cost, quality);
+  EXPECT_TRUE(std::isinf(d[0]) && std::isinf(d[1]));
+  // Dominated area against (4, 0): [1,2) x 1 + [2,4) x 2 = 5; behind points add nothing.
+  EXPECT_DOUBLE_EQ(hypervolume(cost, quality, 4, 0), 5.0);
+  EXPECT_DOUBLE_EQ(hypervolume({1, 2}, {1, 2}, 4, 0), 5.0);
+  EXPECT_DOUBLE_EQ(hypervolume({5}, {1}, 4, 0), 0.0);
+}
+
+TEST(SearchLoop, EvolutionScoresEverySubnetOnceAndBuildsAFront) {
+  const ArchSpec spec = elastic_pan();
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  ScoringEvaluator evaluator(spec);
+  SearchHistory history(temp_file("evolution.jsonl"), false);
+  seed_everything(1);
+  const SearchResult r = run_search(space, evaluator, history, small_search(), "evolution");
+  EXPECT_EQ(r.generations_run, 5);
+  EXPECT_EQ(static_cast<int>(r.evaluated.size()), 60);
+  EXPECT_EQ(evaluator.calls(), 60);
+  std::set<std::string> keys;
+  for (const auto& c : r.evaluated) keys.insert(c.key);
+  EXPECT_EQ(keys.size(), r.evaluated.size());
+  ASSERT_FALSE(r.front.empty());
+  for (size_t i = 1; i < r.front.size(); ++i) {
+    EXPECT_GT(r.front[i].score.latency_ms, r.front[i - 1].score.latency_ms);
+    EXPECT_GT(r.front[i].quality, r.front[i - 1].quality);
+  }
+  // The pick is the best within the budget, or the fastest when nothing fits.
+  const double budget = r.front[r.front.size() / 2].score.latency_ms;
+  EXPECT_EQ(pick_within(r.front, budget).key, r.front[r.front.size() / 2].key);
+  EXPECT_EQ(pick_within(r.front, 0).key, r.front.front().key);
+}
+
+TEST(SearchLoop, EvolutionFindsABetterFrontThanRandomSearchAtAsManyEvaluations) {
+  const ArchSpec spec = elastic_pan(6);
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  ScoringEvaluator evaluator(spec);
   seed_everything(2);
-  auto options = small_search();
-  options.strategy.type = "random";
-  ScoringEvaluator evaluator(enhanced_pan());
-  SearchHistory history(history_path("random"), false);
-  const auto result = run_search(enhanced_pan(), evaluator, history, options);
-  EXPECT_EQ(static_cast<int>(result.evaluated.size()), options.population * options.generations);
+  SearchOptions o = small_search();
+  o.generations = 8;
+  SearchHistory evolution_history(temp_file("e.jsonl"), false), random_history(temp_file("r.jsonl"), false);
+  const SearchResult e = run_search(space, evaluator, evolution_history, o, "evolution");
+  const SearchResult r = run_search(space, evaluator, random_history, small_search("random"), "random");
+  double worst = 1e9;
+  for (const auto* run : {&e, &r})
+    for (const auto& c : run->evaluated) worst = std::min(worst, c.quality);
+  const double latency_ref = evaluator.evaluate(space.full()).latency_ms;
+  EXPECT_GT(front_hypervolume(e.front, latency_ref, worst), front_hypervolume(r.front, latency_ref, worst));
 }
 
-namespace {
-SearchOptions parse_search(const std::string& yaml) {
-  return config::parse_document(config::Document::parse(yaml, "search.yaml"), search_schema());
-}
-std::string search_error(const std::string& yaml) {
-  try {
-    parse_search(yaml);
-  } catch (const Error& e) {
-    return e.what();
+TEST(SearchLoop, AResumedSearchReachesTheSameResult) {
+  const ArchSpec spec = elastic_pan();
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  seed_everything(4);
+  ScoringEvaluator whole(spec);
+  SearchHistory whole_history(temp_file("whole.jsonl"), false);
+  const SearchResult reference = run_search(space, whole, whole_history, small_search(), "evolution");
+
+  // The first run stops after 3 generations (a kill between generations); the second resumes it.
+  const auto path = temp_file("resumed.jsonl");
+  {
+    ScoringEvaluator first(spec);
+    SearchHistory history(path, false);
+    SearchOptions o = small_search();
+    o.generations = 3;
+    run_search(space, first, history, o, "evolution");
   }
-  return "no error";
-}
-}  // namespace
-
-TEST(SearchOptions, EachStrategyHasItsOwnOptionsBlockAndABareNameKeepsItsDefaults) {
-  const auto block = parse_search("strategy: {type: evolution, mutation_rate: 0.3}\n");
-  EXPECT_EQ(block.strategy.type, "evolution");
-  EXPECT_DOUBLE_EQ(block.strategy.evolution.mutation_rate, 0.3);
-  EXPECT_DOUBLE_EQ(block.strategy.evolution.crossover_rate, EvolutionOptions{}.crossover_rate);
-  EXPECT_EQ(parse_search("strategy: random\n").strategy.type, "random");
-  // Written back as the block, which reads back the same.
-  const std::string emitted = config::to_yaml(search_schema().emit(block));
-  EXPECT_NE(emitted.find("type: evolution"), std::string::npos) << emitted;
-  EXPECT_DOUBLE_EQ(parse_search(emitted).strategy.evolution.mutation_rate, 0.3);
-
-  EXPECT_NE(search_error("strategy: evolutoin\n").find("did you mean 'evolution'"), std::string::npos);
-  EXPECT_NE(search_error("strategy: {mutation_rate: 0.3}\n").find("missing required key 'type'"), std::string::npos);
-  EXPECT_NE(search_error("strategy: {type: random, mutation_rate: 0.3}\n")
-                .find("search.yaml:1:26: strategy: the random strategy has no options"),
-            std::string::npos);
-  EXPECT_NE(search_error("strategy: {type: evolution, mutation_rate: 2}\n").find("strategy.mutation_rate"),
-            std::string::npos);
+  EXPECT_THROW(SearchHistory(path, false), Error);  // never overwritten by accident
+  ScoringEvaluator second(spec);
+  SearchHistory history(path, true);
+  const SearchResult resumed = run_search(space, second, history, small_search(), "evolution");
+  EXPECT_EQ(second.calls(), 24);  // only the two generations left
+  ASSERT_EQ(resumed.front.size(), reference.front.size());
+  for (size_t i = 0; i < reference.front.size(); ++i) EXPECT_EQ(resumed.front[i].key, reference.front[i].key);
 }
 
-TEST(SearchOptions, TheFormerSharedOperatorsBlockMovesIntoTheEvolutionBlock) {
-  const auto old = parse_search("strategy: evolution\noperators: {mutation_rate: 0.25}\n");
-  EXPECT_EQ(old.strategy.type, "evolution");
-  EXPECT_DOUBLE_EQ(old.strategy.evolution.mutation_rate, 0.25);
-  // The random strategy never read them.
-  EXPECT_EQ(parse_search("strategy: random\noperators: {mutation_rate: 0.25}\n").strategy.type, "random");
+TEST(SearchLoop, AFailingSubnetFollowsTheFailurePolicy) {
+  const ArchSpec spec = elastic_pan();
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  // Which subnets the first generation proposes: make one of them diverge.
+  seed_everything(5);
+  std::string victim;
+  {
+    ScoringEvaluator probe(spec);
+    SearchHistory history(temp_file("probe.jsonl"), false);
+    SearchOptions o = small_search();
+    o.generations = 1;
+    victim = run_search(space, probe, history, o, "evolution").evaluated.at(3).key;
+  }
+  for (const FailurePolicy policy : {FailurePolicy::Worst, FailurePolicy::Retry, FailurePolicy::Abort}) {
+    SCOPED_TRACE(enum_name(policy));
+    seed_everything(5);
+    ScoringEvaluator evaluator(spec);
+    evaluator.diverging = {victim};
+    const auto path = temp_file("fail_" + enum_name(policy) + ".jsonl");
+    SearchHistory history(path, false);
+    SearchOptions o = small_search();
+    o.on_failure.score = policy;
+    if (policy == FailurePolicy::Abort) {
+      EXPECT_THROW(run_search(space, evaluator, history, o, "evolution"), Error);
+      continue;
+    }
+    const SearchResult r = run_search(space, evaluator, history, o, "evolution");
+    EXPECT_EQ(r.failures, 1);
+    EXPECT_EQ(evaluator.calls(), 60 + (policy == FailurePolicy::Retry ? 1 : 0));
+    for (const auto& c : r.front) EXPECT_NE(c.key, victim);
+    // The history remembers the failure too: a resumed search scores nothing again.
+    seed_everything(5);
+    ScoringEvaluator again(spec);
+    SearchHistory reread(path, true);
+    EXPECT_EQ(run_search(space, again, reread, o, "evolution").failures, 1);
+    EXPECT_EQ(again.calls(), 0);
+  }
 }
 
-// A candidate's score is written into every history line and distributed reply: the keys, their
-// order and null for an unmeasured latency are the format resumed searches read back.
-TEST(CandidateScore, JsonKeepsTheHistoryLineFormatAndReadsBack) {
-  CandidateScore s{/*val_psnr=*/30.5, /*val_ssim=*/0.875, /*image_loss=*/0.25, /*geometry_loss=*/0,
-                   /*params=*/1234,  /*macs=*/56789,     /*latency_ms=*/std::nullopt, /*train_seconds=*/1.5};
-  EXPECT_EQ(nlohmann::ordered_json(s).dump(),
-            R"({"val_psnr":30.5,"val_ssim":0.875,"image_loss":0.25,"geometry_loss":0.0,"params":1234,"macs":56789,)"
-            R"("latency_ms":null,"train_seconds":1.5})");
-  s.latency_ms = 2.25;
-  const std::string line = nlohmann::ordered_json(s).dump();
-  EXPECT_NE(line.find(R"("macs":56789,"latency_ms":2.25,"train_seconds")"), std::string::npos) << line;
-  const auto back = nlohmann::json::parse(line).get<CandidateScore>();
-  EXPECT_EQ(back.val_psnr, s.val_psnr);
-  EXPECT_EQ(back.params, s.params);
-  EXPECT_EQ(back.latency_ms, s.latency_ms);
-  EXPECT_FALSE(nlohmann::json::parse(R"({"val_psnr":1,"val_ssim":1,"image_loss":0,"geometry_loss":0,"params":1,)"
-                                     R"("macs":1,"latency_ms":null,"train_seconds":0})")
-                   .get<CandidateScore>()
-                   .latency_ms);
-  EXPECT_THROW(nlohmann::json::parse(R"({"val_psnr":1})").get<CandidateScore>(), nlohmann::json::exception);
+TEST(InferenceEvaluator, ScoresSubnetsOfARealNetworkOnRenderedCrops) {
+  seed_everything(6);
+  const Dataset data = Dataset::open(test::tiny_data());
+  ArchSpec spec = elastic_pan(2);
+  SRNetwork net(spec);
+  net->eval();
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+  LatencyTableOptions latency;
+  latency.calibration_subnets = 2;
+  latency.check_subnets = 1;
+  latency.runs = 1;
+  latency.subnet_runs = 1;
+  const LatencyTable table = measure_latency_table(*net, space, 32, 24, latency);
+  ValidationCropOptions crops;
+  crops.frames = 2;
+  crops.crops_per_frame = 2;
+  crops.size = 12;
+  crops.margin = 2;
+  InferenceEvaluator evaluator(net, data, crops, table);
+  const int frames = std::min<int>(2, static_cast<int>(data.frames(Split::Val).size()));
+  EXPECT_EQ(evaluator.crops(), 2 * frames);
+  const SubnetScore full = evaluator.evaluate(space.full()), small = evaluator.evaluate(space.smallest());
+  EXPECT_TRUE(std::isfinite(full.psnr) && std::isfinite(small.psnr));
+  EXPECT_GT(full.macs, small.macs);
+  EXPECT_GT(full.latency_ms, 0);
+  // Deterministic: the same subnet scores the same.
+  EXPECT_EQ(evaluator.evaluate(space.smallest()).psnr, small.psnr);
 }

@@ -8,6 +8,7 @@
 #include "core/runtime.h"
 #include "models/arch_spec.h"
 #include "models/elastic.h"
+#include "render_data/patch_sampler.h"
 #include "tests/support/tiny_data.h"
 #include "train/distillation.h"
 #include "train/elastic_training.h"

@@ -1,0 +1,40 @@
+#pragma once
+// The controls stage of `cgsr run`: what a compressed network is measured against at equal
+// latency (pruning/equal_latency_controls.h). The CG-enhanced network is narrowed by weight
+// magnitude to the final network's latency, measured on the fused path in this process: the
+// pruning units alone (MMP), or every layer group alike (uniform width). Each control is then
+// fine-tuned like the final network: the same schedule and the same distillation weight, its
+// teacher the CG-enhanced network it was cut from. Writes <kind>.cgsr per control and
+// results.json (`controls`: name, file, rate, measured and target latency).
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/run_dir.h"
+#include "pipeline/run_settings.h"
+#include "pruning/equal_latency_controls.h"
+#include "train/losses.h"
+#include "train/trainer.h"
+
+namespace cgsr {
+
+struct ControlsOptions {
+  std::vector<ControlKind> kinds = {ControlKind::Magnitude, ControlKind::Uniform};
+};
+config::Schema<ControlsOptions> controls_schema();
+
+struct ControlsJob : RunSettings {
+  ControlsOptions options;
+  std::string enhanced;     // the CG-enhanced model file the controls are cut from
+  std::string final_model;  // the network whose latency they match
+  std::string data;
+  TrainSchedule schedule;   // the final network's fine-tuning
+  LossOptions loss;
+  double distill = 1.0;
+};
+
+nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, bool resume);
+
+}  // namespace cgsr
