@@ -295,9 +295,8 @@ class Pipeline {
                                search_.search.strategy.type, search_.search.population, search_.search.generations,
                                search_.baseline.empty() ? "" : ", and " + search_.baseline + " search as many",
                                search_.pick.latency_fraction, schedule(search_.final.schedule)));
-    line("prune", fmt::format("{} patterns, fine-tuning {}", prune_.pool.keep_rates.size(),
-                              prune_.finetune.epochs > 0 ? fmt::format("{} epochs", prune_.finetune.epochs)
-                                                         : schedule(prune_.finetune.schedule)));
+    line("prune", fmt::format("{} patterns of the front, fine-tuning {}", prune_.pool.latency_factors.size(),
+                              schedule(prune_.finetune.schedule)));
     if (options_.scratch.enabled) line("scratch", fmt::format("the pick's architecture, {} steps", scratch_steps()));
     if (!options_.controls.kinds.empty()) {
       std::vector<std::string> kinds;
@@ -370,7 +369,8 @@ class Pipeline {
     stage_eval_ = eval_;
     stage_eval_.latency_runs = 0;
     YAML::Node prune_filled = YAML::Clone(with_data);
-    prune_filled["model"] = model_file("search").string();
+    prune_filled["model"] = model_file("elastic").string();
+    prune_filled["search"] = (stages_.dir("search") / "results.json").string();
     prune_filled["eval"] = eval_schema_fields().emit(stage_eval_);
     prune_ = parse_stage(options_.prune, prune_command_schema(), prune_filled, "prune");
   }
@@ -459,7 +459,7 @@ class Pipeline {
 
   // Hybrid pruning of the CG-optimized network and its baselines (evaluated with the run's eval options).
   void prune() {
-    pruned_ = stages_.run("prune", prune_command_schema().emit(prune_), {data_hash_, searched_.hash},
+    pruned_ = stages_.run("prune", prune_command_schema().emit(prune_), {data_hash_, elastic_stage_.hash, searched_.hash},
                           [&](RunDir& dir, bool resume) {
                             prune_.resume = resume;
                             return run_prune(prune_, prune_command_schema().emit(prune_), dir);
@@ -478,7 +478,6 @@ class Pipeline {
     std::vector<std::pair<fs::path, std::string>> to_export = {
         {model_file("train"), "backbone"}, {model_file("enhance"), "cg_enhanced"}, {model_file("elastic"), "elastic"},
         {model_file("search"), "cg_optimized"}};
-    for (const auto& b : roles_.baselines) to_export.emplace_back(b.file, b.file.stem().string());
     if (options_.scratch.enabled) to_export.emplace_back(model_file("scratch"), "scratch");
     for (const auto& c : controls_) to_export.emplace_back(c.file, "control_" + c.file.stem().string());
     to_export.emplace_back(pruned_file, "pruned");
@@ -544,7 +543,6 @@ class Pipeline {
     HeldoutJob job;
     job.models = classic_models();
     for (const std::string stage : {"train", "control", "enhance", "search"}) job.models.push_back(model_file(stage).string());
-    for (const auto& b : roles_.baselines) job.models.push_back(b.file.string());
     job.models.push_back(model_file("prune").string());
     for (const auto& extra : control_models()) job.models.push_back(extra.file.string());
     job.scale = backbone_.scale;
@@ -611,7 +609,6 @@ class Pipeline {
                                              {roles_.input.name, model_file("search")},
                                              {roles_.hybrid.name, model_file("prune")},
                                              {roles_.static_network.name, model_file("prune")}};
-    for (const auto& b : roles_.baselines) files[b.name] = b.file;
     files[elastic_.name] = model_file("elastic");
     for (const auto& extra : control_models()) files[extra.name] = extra.file;
     return files;
@@ -665,11 +662,13 @@ class Pipeline {
     roles.cg_optimized = find_result(own_, roles_.input.name);
     roles.pruned = find_result(own_, roles_.hybrid.name);
     roles.pruned_static = find_result(own_, roles_.static_network.name);
-    if (const auto* mmp = roles_.baseline("magnitude")) roles.magnitude = find_result(own_, mmp->name);
     roles.elastic = find_result(own_, elastic_.name);
     if (options_.scratch.enabled) roles.scratch = find_result(own_, scratch_.name);
     for (const auto& c : controls_)
-      if (const auto* r = find_result(own_, c.name)) roles.controls.push_back(r);
+      if (const auto* r = find_result(own_, c.name)) {
+        roles.controls.push_back(r);
+        if (c.file.stem() == enum_name(ControlKind::Magnitude)) roles.magnitude = r;
+      }
     const auto& searches = searched_.summary.at("searches");
     for (const auto& [strategy, stats] : searches.items())
       roles.searches.push_back({strategy, stats.at("evaluations").get<int>(), stats.at("hypervolume").get<double>()});

@@ -1,10 +1,9 @@
 #pragma once
-// The prune job: what `cgsr prune` runs, and the prune stage of `cgsr run`. Hybrid pruning of a
-// trained model for one scene (pruning/pruner.h). Writes
-// pruned.cgsr (the statically pruned network with its dynamic pruning component), one
-// baseline<i>_<type>.cgsr per static baseline (magnitude pruning by default), pool.json,
-// fine-tuning checkpoints (for --resume) and results.json: `roles` names each model and its
-// file, and `evaluations` (input model, baselines, static, hybrid) feed `cgsr report`.
+// The prune job: what `cgsr prune` runs, and the prune stage of `cgsr run`. Hybrid pruning among
+// the subnets a search found in an elastic network (pruning/pruner.h). Writes pruned.cgsr (the
+// statically pruned network with its dynamic pruning component), pool.json, the fine-tuning
+// checkpoint (for --resume) and results.json: `roles` names each model and its file, and
+// `evaluations` (the search's pick, the static network, the hybrid model) feed `cgsr report`.
 
 #include <nlohmann/json.hpp>
 
@@ -15,7 +14,8 @@
 namespace cgsr {
 
 struct PruneCommandOptions : RunSettings, PruneOptions {
-  std::string model;    // trained model file (required)
+  std::string model;    // the elastic model file the search ran on (required)
+  std::string search;   // the search's results.json (required)
   std::string data;     // data set directory (required)
   bool resume = false;  // continue the fine-tuning from the run directory's checkpoints
 };

@@ -5,53 +5,26 @@
 
 #include <cmath>
 #include <numeric>
-#include <random>
 
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/progress.h"
 #include "render_data/patch_sampler.h"
-#include "train/losses.h"
 
 namespace cgsr {
 
-FinetuneOptions::FinetuneOptions() {
-  schedule.lr_max = 2e-4;
-  schedule.lr_min = 1e-6;
-  schedule.validate_every = 0;
-  loss.lambda_geometry = 0;  // L_p has no geometry term (and pruned models drop the head)
-  loss.lambda_shrink = 0;
-}
-
-config::Schema<FinetuneOptions> finetune_schema() {
-  config::Schema<FinetuneOptions> s;
-  s.field("epochs", &FinetuneOptions::epochs,
-          "passes over the training frames' pixels (paper: 2 per dynamic pruning run); 0 = schedule.steps")
-      .range(0.0, 1000.0);
-  s.section("schedule", &FinetuneOptions::schedule, schedule_schema(), "optimization schedule");
-  s.section("loss", &FinetuneOptions::loss, loss_schema(), "image term (L2 in the paper) and RIT gate penalty");
-  s.field("lambda_pruned", &FinetuneOptions::lambda_pruned,
-          "weight of the L1 norm of the weights a pattern leaves out (Eq. 4)")
-      .at_least(0);
-  s.field("sampled_patterns", &FinetuneOptions::sampled_patterns,
-          "patterns between the widest and the narrowest trained per step (sandwich rule)")
-      .range(0, 64);
-  s.field("distill", &FinetuneOptions::distill,
-          "narrower patterns learn the widest pattern's output instead of the HR frame (in-place distillation)");
-  return s;
-}
-
 const std::vector<std::string>& EnumNames<PatternCost>::names() {
-  static const std::vector<std::string> n{"macs", "latency"};
+  static const std::vector<std::string> n{"macs", "latency", "predicted"};
   return n;
 }
 
 config::Schema<SelectorOptions> selector_schema() {
   config::Schema<SelectorOptions> s;
-  s.field("cost", &SelectorOptions::cost, "what a pattern costs: macs (reproducible) or latency (measured here)");
+  s.field("cost", &SelectorOptions::cost,
+          "what a pattern costs: predicted (the latency table's, reproducible), latency (measured here) or macs");
   s.field("budget", &SelectorOptions::budget,
-          "mean per-frame cost the choices aim at, as a fraction of the widest pattern's")
-      .check([](double v) { return v > 0 && v <= 1; }, "must be in (0, 1]");
+          "mean per-frame cost the choices aim at, as a fraction of the widest pattern's (0: the pick's)")
+      .check([](double v) { return v >= 0 && v <= 1; }, "must be in [0, 1]");
   s.field("temperature", &SelectorOptions::temperature,
           "dB: cost differences below this count as near-ties when the sampler is fitted")
       .range(1e-6, 100.0);
@@ -61,18 +34,6 @@ config::Schema<SelectorOptions> selector_schema() {
   s.field("latency_runs", &SelectorOptions::latency_runs, "rounds timing every pattern for the latency table")
       .range(1, 1000);
   return s;
-}
-
-int finetune_steps(const FinetuneOptions& options, const Dataset& data, int scale) {
-  if (options.epochs <= 0) return options.schedule.steps;
-  const auto frames = data.frames(Split::Train);
-  if (frames.empty()) throw Error(data.info().root.string(), "the data set has no training frames");
-  const auto [lr, hr] = resolution_pair(data, scale);
-  const auto& r = data.resolutions()[lr];
-  const double pixels = static_cast<double>(frames.size()) * r.width * r.height;
-  const double per_step = static_cast<double>(options.schedule.batch_size) * options.schedule.patch_size *
-                          options.schedule.patch_size;
-  return std::max(1, static_cast<int>(std::ceil(options.epochs * pixels / per_step)));
 }
 
 nlohmann::ordered_json to_json(const SelectorFit& fit) {
@@ -103,7 +64,6 @@ DynamicPruning::DynamicPruning(SRNetwork network, const Dataset& data, PatternPo
       throw Error(data.info().root.string(), "the dynamic sampler reads rendering channel '" + channel_name(c) +
                                                  "', which the data set does not have");
   samplers_ = DynamicSamplers(options, std::vector<int>{pool_.size()});
-  masks_ = std::make_unique<PatternMasks>(*network_, pool_);
 }
 
 torch::Tensor DynamicPruning::sampler_input(int frame) {
@@ -123,50 +83,6 @@ torch::Tensor DynamicPruning::sampler_inputs(const std::vector<int>& frames) {
   std::vector<torch::Tensor> parts;
   for (int f : frames) parts.push_back(sampler_input(f));
   return torch::cat(parts, 0);
-}
-
-namespace {
-// The patterns besides the widest that a step trains: the narrowest and `sampled` distinct
-// others, drawn from the step number (the same after a resume).
-std::vector<int> sandwich(int patterns, int sampled, int step) {
-  std::vector<int> out;
-  if (patterns < 2) return out;
-  out.push_back(patterns - 1);
-  std::vector<int> middle(patterns - 2);
-  std::iota(middle.begin(), middle.end(), 1);
-  std::mt19937 rng(static_cast<uint32_t>(step) * 2654435761u + 17u);
-  std::shuffle(middle.begin(), middle.end(), rng);
-  for (int i = 0; i < sampled && i < static_cast<int>(middle.size()); ++i) out.push_back(middle[i]);
-  return out;
-}
-}  // namespace
-
-TrainHooks DynamicPruning::hooks(const FinetuneOptions& options) {
-  TrainHooks hooks;
-  // The widest pattern is the trainer's own forward (and what validation measures).
-  hooks.forward = [this](const Batch& batch, int) {
-    TrainOutput out;
-    out.image = masks_->forward(batch.lr_color, network_->info_input(batch),
-                                masks_->group_masks(0, batch.lr_color.size(0)));
-    return out;
-  };
-  const LossOptions loss = options.loss;
-  const double lambda = options.lambda_pruned;
-  const int sampled = options.sampled_patterns;
-  const bool distill = options.distill;
-  hooks.extra_loss = [this, loss, lambda, sampled, distill](const Batch& batch, const TrainOutput& widest, int step) {
-    const int64_t n = batch.lr_color.size(0);
-    auto total = lambda > 0 ? lambda * masks_->pruned_weight_l1(masks_->group_masks(0, n)) : torch::zeros({});
-    const auto target = distill ? widest.image.detach() : batch.hr_color;
-    for (int k : sandwich(pool_.size(), sampled, step)) {
-      const auto masks = masks_->group_masks(k, n);
-      const auto out = masks_->forward(batch.lr_color, network_->info_input(batch), masks);
-      total = total + reconstruction_error(out, target, loss.image_norm);
-      if (lambda > 0) total = total + lambda * masks_->pruned_weight_l1(masks);
-    }
-    return total;
-  };
-  return hooks;
 }
 
 namespace {
@@ -190,7 +106,8 @@ double mean_fraction(const std::vector<int>& choice, const std::vector<double>& 
 }
 }  // namespace
 
-SelectorFit DynamicPruning::fit_selector(const std::vector<int>& frames, const SelectorOptions& options) {
+SelectorFit DynamicPruning::fit_selector(const std::vector<int>& frames, const SelectorOptions& options,
+                                         const LatencyTable* table) {
   if (frames.empty()) throw Error("dynamic pruning", "no frames to fit the pattern choice on");
   SelectorFit fit;
   fit.frames = frames;
@@ -205,10 +122,17 @@ SelectorFit DynamicPruning::fit_selector(const std::vector<int>& frames, const S
     const auto info = network_->info_input(b);
     for (const auto& l : networks.measure_latency(b.lr_color, info, options.latency_runs))
       fit.latency_ms.push_back(l.median_ms);
-    std::vector<double> macs;
-    for (int k = 0; k < patterns; ++k)
+    std::vector<double> macs, predicted;
+    for (int k = 0; k < patterns; ++k) {
       macs.push_back(static_cast<double>(networks.cost(k, b.lr_color.size(3), b.lr_color.size(2)).macs));
-    const auto& measure = options.cost == PatternCost::Macs ? macs : fit.latency_ms;
+      if (options.cost == PatternCost::Predicted) {
+        if (!table) throw Error("dynamic pruning", "selector.cost is predicted, but there is no latency table");
+        predicted.push_back(table->predict(networks.graph(k)));
+      }
+    }
+    const auto& measure = options.cost == PatternCost::Macs        ? macs
+                          : options.cost == PatternCost::Predicted ? predicted
+                                                                   : fit.latency_ms;
     for (double v : measure) fit.cost.push_back(v / measure.front());
   }
   const std::vector<double>& fraction = fit.cost;
@@ -237,14 +161,15 @@ SelectorFit DynamicPruning::fit_selector(const std::vector<int>& frames, const S
 
   // The price of latency that meets the budget on average.
   double low = 0, high = 1;
-  if (mean_fraction(cheapest(fit.loss_db, fraction, 0), fraction) <= options.budget) {
+  const double budget = options.budget > 0 ? options.budget : 1.0;
+  if (mean_fraction(cheapest(fit.loss_db, fraction, 0), fraction) <= budget) {
     high = 0;
   } else {
-    while (mean_fraction(cheapest(fit.loss_db, fraction, high), fraction) > options.budget && high < 1e6)
+    while (mean_fraction(cheapest(fit.loss_db, fraction, high), fraction) > budget && high < 1e6)
       high *= 2;
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (low + high);
-      (mean_fraction(cheapest(fit.loss_db, fraction, mid), fraction) > options.budget ? low : high) = mid;
+      (mean_fraction(cheapest(fit.loss_db, fraction, mid), fraction) > budget ? low : high) = mid;
     }
   }
   fit.price = high;

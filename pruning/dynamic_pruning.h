@@ -1,28 +1,15 @@
 #pragma once
-// Training the dynamic pruning of a network on a data set, in two steps:
-//
-//   1. hooks(): the Trainer fine-tunes the network so that every nested pattern of the pool
-//      (pattern_pool.h) works on its own, by the sandwich rule: each step trains the widest
-//      pattern (the trainer's own loss), the narrowest and `sampled_patterns` others drawn per
-//      step, each with L_p = ||HR - SR||_2 + lambda_pruned * ||W_P||_1 (Eq. 4 of the paper, W_P
-//      the weights the pattern leaves out; pattern_masks.h). lambda_pruned is 0 by default: with
-//      nested patterns every weight a narrow pattern leaves out is one a wider pattern uses, and
-//      the L1 term (a sum over those weights) shrank them until the static network lost 0.24 dB
-//      on the quickstart at 1e-4 (docs/results/dynamic_pruning.md). The widest pattern, the static
-//      network, is itself trained. With `distill` the narrower patterns learn the widest's
-//      output (detached) instead of the HR frame (in-place distillation, as slimmable networks
-//      are trained): their gradients then pull the shared channels toward what the widest
-//      computes rather than away from it.
-//   2. fit_selector(): the dynamic pruning component (the sampler, dynamic_sampler.h) learns to
-//      choose a pattern per frame from the rendering information of that frame and the one
-//      before. On every training frame each pattern's PSNR loss against the widest is measured
-//      on the full frame, and each pattern's cost: its MACs or its latency on this machine (the
-//      latency table), as a fraction of the widest pattern's. A frame's cost of pattern k is
-//      loss_dB[k] + lambda * cost[k], with lambda the smallest price for which the frames'
-//      cheapest patterns meet the budget on average: easy frames (little geometry, little
-//      motion) take narrow patterns, hard ones wide. The sampler is fitted to the softmax of -cost / temperature per frame
-//      (cross-entropy): Eq. 4's image term plus a latency term, made a distribution so that
-//      frames where patterns cost about the same do not pull hard either way.
+// The dynamic pruning component of a network with a pattern pool (pattern_pool.h): it learns to
+// choose a pattern per frame from the rendering information of that frame and the one before
+// (the sampler, dynamic_sampler.h). fit_selector() measures, on every training frame, each
+// pattern's PSNR loss against the widest on the full frame, and each pattern's cost: its latency
+// predicted by the latency table (reproducible), its latency measured on this machine, or its
+// MACs, as a fraction of the widest pattern's. A frame's cost of pattern k is
+// loss_dB[k] + lambda * cost[k], with lambda the smallest price for which the frames' cheapest
+// patterns meet the budget on average: easy frames (little geometry, little motion) take narrow
+// patterns, hard ones wide. The sampler is fitted to the softmax of -cost / temperature per frame
+// (cross-entropy): Eq. 4's image term plus a latency term, made a distribution so that frames
+// where patterns cost about the same do not pull hard either way.
 
 #include <map>
 #include <memory>
@@ -30,42 +17,28 @@
 
 #include "core/config.h"
 #include "core/enum_names.h"
+#include "models/latency_table.h"
 #include "models/sr_network.h"
 #include "pruning/dynamic_sampler.h"
-#include "pruning/pattern_masks.h"
 #include "pruning/pattern_networks.h"
 #include "pruning/pattern_pool.h"
 #include "render_data/dataset.h"
-#include "train/trainer.h"
 
 namespace cgsr {
 
-struct FinetuneOptions {
-  double epochs = 2;             // passes over the training frames' LR pixels; 0: schedule.steps
-  TrainSchedule schedule;        // batch, patch size, learning rates (steps from epochs when > 0)
-  LossOptions loss;              // the image term of L_p (and the RIT gate penalty)
-  double lambda_pruned = 0;      // weight of ||W_P||_1 (see above)
-  int sampled_patterns = 1;      // patterns between the widest and the narrowest trained per step
-  bool distill = true;           // narrower patterns learn the widest's output, not the HR frame
-  FinetuneOptions();
-};
-config::Schema<FinetuneOptions> finetune_schema();
-
-// Optimizer steps of `options` on `data`'s training frames at `scale`.
-int finetune_steps(const FinetuneOptions& options, const Dataset& data, int scale);
-
-// What a pattern costs when the choice is fitted. MACs make the choice reproducible; a latency
-// table measured on a shared machine can differ between two runs, and the choice with it.
-enum class PatternCost { Macs, Latency };
+// What a pattern costs when the choice is fitted. Predicted latency (the latency table) and MACs
+// make the choice reproducible; latency measured on a shared machine can differ between two runs,
+// and the choice with it.
+enum class PatternCost { Macs, Latency, Predicted };
 template <>
 struct EnumNames<PatternCost> {
   static constexpr const char* kind = "pattern cost";
-  static const std::vector<std::string>& names();  // macs, latency
+  static const std::vector<std::string>& names();  // macs, latency, predicted
 };
 
 struct SelectorOptions {
-  PatternCost cost = PatternCost::Macs;
-  double budget = 0.75;          // mean per-frame cost, as a fraction of the widest pattern's
+  PatternCost cost = PatternCost::Predicted;
+  double budget = 0;             // mean per-frame cost, as a fraction of the widest pattern's (0: the pick's)
   double temperature = 0.02;     // dB: cost differences below this are near-ties
   int steps = 400;               // optimizer steps (full batch of the training frames)
   double learning_rate = 1e-2;
@@ -97,11 +70,10 @@ class DynamicPruning {
   torch::Tensor sampler_input(int frame);
   torch::Tensor sampler_inputs(const std::vector<int>& frames);
 
-  // Trainer hooks of the sandwich fine-tuning.
-  TrainHooks hooks(const FinetuneOptions& options);
-
-  // Step 2 on `frames` with the network as it is now.
-  SelectorFit fit_selector(const std::vector<int>& frames, const SelectorOptions& options);
+  // The choice fitted on `frames` with the network as it is now; `table` prices the patterns
+  // when options.cost is predicted. A budget of 0 reads as 1 (the caller sets the pick's).
+  SelectorFit fit_selector(const std::vector<int>& frames, const SelectorOptions& options,
+                           const LatencyTable* table = nullptr);
 
   // [pattern]: frames among `frames` for which the sampler chooses it.
   std::vector<int64_t> selection_counts(const std::vector<int>& frames);
@@ -116,7 +88,6 @@ class DynamicPruning {
   PatternPool pool_;
   DynamicSamplers samplers_{nullptr};
   std::vector<RenderChannel> channels_;
-  std::unique_ptr<PatternMasks> masks_;
   std::map<int, torch::Tensor> inputs_;
 };
 

@@ -13,7 +13,7 @@ namespace cgsr {
 
 namespace {
 constexpr const char* kKey = "dynamic_pruning";
-constexpr int kFormat = 2;
+constexpr int kFormat = 3;
 const std::string kPrefix = std::string(kExtraTensorPrefix) + "dpc.";
 }  // namespace
 
@@ -71,8 +71,7 @@ HybridModel load_hybrid_model(const std::filesystem::path& path) {
     throw e.within(where);
   }
   if (options.grid < 2 || options.width < 1) throw Error(where, "invalid dynamic sampler settings");
-  const auto units = find_units(model.network->describe(false));
-  model.pool = pool_from_json(j.at("pool"), units, where);
+  model.pool = pool_from_json(j.at("pool"), model.network->spec(), where);
   if (model.latency.median_ms.size() != static_cast<size_t>(model.pool.size()))
     throw Error(where, "the latency table has " + std::to_string(model.latency.median_ms.size()) +
                            " entries, the pool " + std::to_string(model.pool.size()) + " patterns");

@@ -1,11 +1,12 @@
 #pragma once
 // A hybrid-pruned model: the statically pruned network plus its dynamic pruning component (the
-// sampler and the pool of nested patterns) and the patterns' latency table, in one model file.
+// sampler and the pool of patterns, subnets of the network) and the patterns' measured latency,
+// in one model file.
 //
 // The file is an ordinary model file (models/model_file.h): the network's parameters under their
 // usual names, the samplers' tensors under "extra.dpc.", and the pool and sampler settings in
-// provenance.extra["dynamic_pruning"] (format 2; format 1, per-unit pattern pools of equal cost,
-// is no longer read). load_model() therefore reads the static network alone
+// provenance.extra["dynamic_pruning"] (format 3: the patterns as subnets; formats 1 and 2, nested
+// channel patterns, are no longer read). load_model() therefore reads the static network alone
 // (export, bench and eval of the static part work unchanged); load_hybrid_model() reads all.
 
 #include <filesystem>
@@ -25,8 +26,8 @@ struct PatternLatency {
 };
 
 struct HybridModel {
-  SRNetwork network{nullptr};  // statically pruned (the widest pattern); runs dense on its own
-  PatternPool pool;            // nested patterns of the network
+  SRNetwork network{nullptr};  // statically pruned (the union of the patterns); runs dense on its own
+  PatternPool pool;            // the patterns, subnets of the network, widest first
   DynamicSamplers samplers{nullptr};  // one head scoring the pool's patterns
   PatternLatency latency;
   Provenance provenance;

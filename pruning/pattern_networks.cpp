@@ -7,20 +7,18 @@
 namespace cgsr {
 
 PatternNetworks::PatternNetworks(const SRNetworkImpl& net, PatternPool pool) : pool_(std::move(pool)) {
+  CGSR_CHECK(pool_.spec == net.spec(), "pattern networks: the pool belongs to another network");
   torch::NoGradGuard no_grad;
-  graph::Graph widest = net.describe(false);
-  for (auto& op : widest.ops) {  // a snapshot: the views must not track later training
-    if (op.weight.defined()) op.weight = op.weight.detach().clone();
-    if (op.bias.defined()) op.bias = op.bias.detach().clone();
-    if (op.scale.defined()) op.scale = op.scale.detach().clone();
-    if (op.shift.defined()) op.shift = op.shift.detach().clone();
+  for (const auto& pattern : pool_.patterns) {
+    graph::Graph g = subnet_graph(net, pattern);
+    for (auto& op : g.ops) {  // a snapshot: later training of the network must not change a pattern
+      if (op.weight.defined()) op.weight = op.weight.detach().clone();
+      if (op.bias.defined()) op.bias = op.bias.detach().clone();
+      if (op.scale.defined()) op.scale = op.scale.detach().clone();
+      if (op.shift.defined()) op.shift = op.shift.detach().clone();
+    }
+    graphs_.push_back(std::move(g));
   }
-  const auto units = find_units(widest);
-  CGSR_CHECK(units.size() == pool_.units.size(), "pattern networks: the pool does not match the network's units");
-  for (size_t u = 0; u < units.size(); ++u)
-    CGSR_CHECK(units[u].groups == pool_.units[u].groups && units[u].widths == pool_.units[u].widths,
-               "pattern networks: pool unit " + pool_.units[u].name + " does not match the network");
-  for (int k = 0; k < pool_.size(); ++k) graphs_.push_back(select_channels(widest, pool_.selection(k)));
   fused_.resize(graphs_.size());
 }
 

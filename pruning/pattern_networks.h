@@ -1,9 +1,8 @@
 #pragma once
-// The patterns of a pool (pattern_pool.h) as networks that run: pattern k is the network's graph
-// narrowed to the first channels of every unit group, its weights leading slices (views) of the
-// widest weights (gathered only along an axis that concatenates unit groups, such as PAN's
-// conv3 input), executed by cgsr's fast path (models/fused_graph.h) like any static network.
-// Choosing a pattern per frame costs nothing beyond running that pattern: no weights move.
+// The patterns of a pool (pattern_pool.h) as networks that run: pattern k is the network's
+// subnet graph (models/subnet.h), executed by cgsr's fast path (models/fused_graph.h) like any
+// static network. Choosing a pattern per frame costs nothing beyond running that pattern: every
+// pattern is built before the first frame, and no weights move.
 //
 //   PatternNetworks patterns(*net, pool);
 //   auto sr = patterns.run(2, lr_color, net->info_input(batch));   // pattern 2 of the pool
@@ -18,6 +17,7 @@
 #include "models/fused_graph.h"
 #include "models/graph.h"
 #include "models/sr_network.h"
+#include "models/subnet.h"
 #include "pruning/pattern_pool.h"
 
 namespace cgsr {
@@ -25,14 +25,14 @@ namespace cgsr {
 class PatternNetworks {
  public:
   // Reads `net`'s weights now (later changes to the network are not seen). The pool must
-  // belong to the network (its units).
+  // belong to the network (pool.spec).
   PatternNetworks(const SRNetworkImpl& net, PatternPool pool);
   ~PatternNetworks();
 
   int size() const { return pool_.size(); }
   const PatternPool& pool() const { return pool_; }
 
-  // The narrowed graph of pattern k; its tensors are views of the widest graph's.
+  // The subnet graph of pattern k.
   const graph::Graph& graph(int k) const;
   // [N, 3, s*h, s*w]; `info` as for SRNetworkImpl::forward (undefined without RIT). No autograd.
   torch::Tensor run(int k, const torch::Tensor& lr_color, const torch::Tensor& info);

@@ -1,166 +1,151 @@
 #include "pruning/pattern_pool.h"
 
-#include <torch/torch.h>
-
 #include <algorithm>
-#include <numeric>
+#include <cmath>
+#include <limits>
 
 #include "core/error.h"
+#include "core/text.h"
+#include "models/backbone_registry.h"
 
 namespace cgsr {
 
 config::Schema<PoolOptions> pool_schema() {
   config::Schema<PoolOptions> s;
-  s.field("keep_rates", &PoolOptions::keep_rates,
-          "per pattern, the fraction of every unit group's channels it keeps (widest first, strictly decreasing)")
+  s.field("latency_factors", &PoolOptions::latency_factors,
+          "pattern k: the front point nearest this multiple of the pick's predicted latency")
       .check(
-          [](const std::vector<double>& v) {
-            if (v.empty()) return false;
-            for (size_t i = 0; i < v.size(); ++i)
-              if (!(v[i] > 0 && v[i] <= 1) || (i > 0 && v[i] >= v[i - 1])) return false;
+          [](const std::vector<double>& f) {
+            if (f.empty()) return false;
+            for (size_t i = 0; i < f.size(); ++i)
+              if (!(f[i] > 0) || (i > 0 && f[i] >= f[i - 1])) return false;
             return true;
           },
-          "must be strictly decreasing rates in (0, 1]");
+          "must be positive and strictly decreasing (the widest pattern first)");
   return s;
-}
-
-ChannelSelection PatternPool::selection(int k) const {
-  CGSR_CHECK(k >= 0 && k < size(), "pattern index " + std::to_string(k) + " out of range");
-  ChannelSelection out;
-  for (const auto& [group, width] : widths[k]) {
-    std::vector<int64_t> c(width);
-    std::iota(c.begin(), c.end(), 0);
-    out[group] = std::move(c);
-  }
-  return out;
 }
 
 double PatternPool::channel_fraction(int k) const {
   CGSR_CHECK(k >= 0 && k < size(), "pattern index " + std::to_string(k) + " out of range");
-  int64_t kept = 0, total = 0;
-  for (const auto& u : units) {
-    for (size_t i = 0; i < u.groups.size(); ++i) {
-      kept += widths[k].at(u.groups[i]);
-      total += u.widths[i];
-    }
+  const SubnetConfig full = full_subnet(spec);
+  double kept = 0, all = 0;
+  for (const auto& [group, width] : full.widths) {
+    all += static_cast<double>(width);
+    const auto block = parse_block_group(group);
+    const auto& blocks = patterns[k].blocks;
+    if (block && !std::binary_search(blocks.begin(), blocks.end(), block->first)) continue;
+    kept += static_cast<double>(subnet_width(patterns[k], group, width));
   }
-  return total ? static_cast<double>(kept) / static_cast<double>(total) : 1.0;
+  return all > 0 ? kept / all : 1.0;
 }
 
-PatternPool nested_pool(const std::vector<PrunableUnit>& units, const std::vector<double>& keep_rates) {
-  if (keep_rates.empty()) throw Error("pattern pool", "needs at least one keep rate");
+PatternPool pool_from_front(const ArchSpec& spec, const std::vector<Candidate>& front, double pick_latency_ms,
+                            const PoolOptions& options) {
+  if (front.empty()) throw Error("pattern pool", "the search's front is empty");
   PatternPool pool;
-  pool.units = units;
-  for (size_t k = 0; k < keep_rates.size(); ++k) {
-    const double rate = keep_rates[k];
-    if (!(rate > 0 && rate <= 1) || (k > 0 && rate >= keep_rates[k - 1]))
-      throw Error("pattern pool", "keep rates must be strictly decreasing in (0, 1]");
-    std::map<std::string, int64_t> w;
-    for (const auto& u : units)
-      for (size_t i = 0; i < u.groups.size(); ++i) w[u.groups[i]] = kept_count(u.widths[i], rate);
-    if (k > 0 && w == pool.widths.back())
-      throw Error("pattern pool", "keep rates " + std::to_string(keep_rates[k - 1]) + " and " + std::to_string(rate) +
-                                      " keep the same channels of every group (the groups are too narrow)");
-    pool.widths.push_back(std::move(w));
+  pool.spec = spec;
+  std::vector<bool> taken(front.size(), false);
+  for (double factor : options.latency_factors) {
+    const double target = factor * pick_latency_ms;
+    size_t best = front.size();
+    for (size_t i = 0; i < front.size(); ++i) {
+      if (taken[i]) continue;
+      if (best == front.size() || std::abs(front[i].score.latency_ms - target) <
+                                      std::abs(front[best].score.latency_ms - target))
+        best = i;
+    }
+    if (best == front.size()) break;
+    taken[best] = true;
+  }
+  // Widest first: the front is fastest first.
+  for (size_t i = front.size(); i-- > 0;)
+    if (taken[i]) pool.patterns.push_back(front[i].subnet);
+  for (const auto& p : pool.patterns) {
+    const auto problems = subnet_problems(spec, p);
+    if (!problems.empty()) throw Error("pattern pool", subnet_key(p) + ": " + join(problems, "; "));
   }
   return pool;
 }
 
-PatternPool keep_patterns(const PatternPool& pool, const std::vector<int>& kept,
-                          const std::vector<PrunableUnit>& narrowed_units) {
-  CGSR_CHECK(!kept.empty(), "keep_patterns: keep at least one pattern");
-  PatternPool out;
-  out.units = narrowed_units;
-  for (size_t i = 0; i < kept.size(); ++i) {
-    CGSR_CHECK(kept[i] >= 0 && kept[i] < pool.size() && (i == 0 || kept[i] > kept[i - 1]),
-               "keep_patterns: pattern indices must be increasing and in range");
-    out.widths.push_back(pool.widths[kept[i]]);
+SubnetConfig pool_union(const PatternPool& pool) {
+  CGSR_CHECK(pool.size() > 0, "pool_union: an empty pool");
+  SubnetConfig out;
+  const SubnetConfig full = full_subnet(pool.spec);
+  for (const auto& p : pool.patterns)
+    for (int b : p.blocks)
+      if (std::find(out.blocks.begin(), out.blocks.end(), b) == out.blocks.end()) out.blocks.push_back(b);
+  std::sort(out.blocks.begin(), out.blocks.end());
+  for (const auto& [group, width] : full.widths) {
+    int64_t widest = 0;
+    for (const auto& p : pool.patterns) {
+      const auto block = parse_block_group(group);
+      if (block && !std::binary_search(p.blocks.begin(), p.blocks.end(), block->first)) continue;
+      widest = std::max(widest, subnet_width(p, group, width));
+    }
+    out.widths[group] = widest > 0 ? widest : width;  // a group of a block no pattern keeps
   }
-  for (const auto& u : out.units)
-    for (size_t i = 0; i < u.groups.size(); ++i)
-      CGSR_CHECK(out.widths.front().at(u.groups[i]) == u.widths[i],
-                 "keep_patterns: the narrowed network must keep the widest pattern's channels of " + u.groups[i]);
   return out;
 }
 
-ChannelSelection importance_order(const std::vector<PrunableUnit>& units,
-                                  const std::vector<FrameImportance>& frames) {
-  if (frames.empty()) throw Error("pattern pool", "no frames to rank channels on");
-  ChannelSelection order;
-  for (const auto& u : units)
-    for (size_t i = 0; i < u.groups.size(); ++i) {
-      const auto& g = u.groups[i];
-      auto total = torch::zeros({u.widths[i]}, torch::kDouble);
-      for (const auto& f : frames) {
-        const auto it = f.find(g);
-        if (it == f.end()) throw Error("pattern pool", "no importance for layer group " + g, ErrorKind::Internal);
-        const auto s = it->second.detach().to(torch::kDouble).flatten();
-        CGSR_CHECK(s.numel() == u.widths[i], "importance of " + g + " has the wrong size");
-        const double sum = s.sum().item<double>();
-        if (sum > 0 && std::isfinite(sum)) total += s / sum;
+PatternPool rebase_pool(const PatternPool& pool, const SubnetConfig& onto, const ArchSpec& spec) {
+  PatternPool out;
+  out.spec = spec;
+  const auto position = [&](int block) {
+    const auto at = std::lower_bound(onto.blocks.begin(), onto.blocks.end(), block);
+    CGSR_CHECK(at != onto.blocks.end() && *at == block, "rebase_pool: block " + std::to_string(block) +
+                                                            " is not in the network the pool moves to");
+    return static_cast<int>(at - onto.blocks.begin());
+  };
+  for (const auto& p : pool.patterns) {
+    SubnetConfig q;
+    for (int b : p.blocks) q.blocks.push_back(position(b));
+    for (const auto& [group, width] : p.widths) {
+      const auto block = parse_block_group(group);
+      if (!block) {
+        q.widths[group] = width;
+      } else if (std::binary_search(p.blocks.begin(), p.blocks.end(), block->first)) {
+        q.widths[block_group(position(block->first), block->second)] = width;
       }
-      const auto t = total.contiguous();
-      const double* p = t.data_ptr<double>();
-      std::vector<int64_t> idx(u.widths[i]);
-      std::iota(idx.begin(), idx.end(), 0);
-      std::stable_sort(idx.begin(), idx.end(), [p](int64_t a, int64_t b) { return p[a] > p[b]; });
-      order[g] = std::move(idx);
     }
-  return order;
+    const auto problems = subnet_problems(spec, q);
+    CGSR_CHECK(problems.empty(), "rebase_pool: " + join(problems, "; "));
+    out.patterns.push_back(std::move(q));
+  }
+  return out;
 }
 
-Inheritance order_channels(const SRNetworkImpl& net, const ChannelSelection& order) {
-  Inheritance result = inherit(net, net.spec(), order);
-  result.network->train(net.is_training());
-  return result;
+PatternPool chosen_patterns(const PatternPool& pool, const std::vector<int64_t>& counts, std::vector<int>& kept) {
+  CGSR_CHECK(counts.size() == static_cast<size_t>(pool.size()), "chosen_patterns: one count per pattern");
+  PatternPool out;
+  out.spec = pool.spec;
+  kept.clear();
+  for (int k = 0; k < pool.size(); ++k)
+    if (counts[k] > 0) {
+      kept.push_back(k);
+      out.patterns.push_back(pool.patterns[k]);
+    }
+  if (kept.empty()) throw Error("static pruning", "no frame chose any pattern");
+  return out;
 }
 
 nlohmann::ordered_json to_json(const PatternPool& pool) {
-  auto units = nlohmann::ordered_json::array();
-  for (const auto& u : pool.units) units.push_back({{"unit", u.name}, {"groups", u.groups}, {"widths", u.widths}});
   auto patterns = nlohmann::ordered_json::array();
-  for (const auto& w : pool.widths) {
-    nlohmann::ordered_json p = nlohmann::ordered_json::object();
-    for (const auto& u : pool.units)
-      for (const auto& g : u.groups) p[g] = w.at(g);
-    patterns.push_back(p);
-  }
-  return {{"units", units}, {"patterns", patterns}};
+  for (const auto& p : pool.patterns) patterns.push_back(to_json(p));
+  return {{"patterns", patterns}};
 }
 
-PatternPool pool_from_json(const nlohmann::ordered_json& j, const std::vector<PrunableUnit>& units,
-                           const std::string& context) {
+PatternPool pool_from_json(const nlohmann::ordered_json& j, const ArchSpec& spec, const std::string& context) {
   PatternPool pool;
-  pool.units = units;
+  pool.spec = spec;
   try {
-    const auto& ju = j.at("units");
-    if (!ju.is_array() || ju.size() != units.size())
-      throw Error(context, "the pattern pool has " + std::to_string(ju.is_array() ? ju.size() : 0) +
-                               " units, the network " + std::to_string(units.size()));
-    for (size_t u = 0; u < units.size(); ++u) {
-      const auto& e = ju[u];
-      if (e.at("unit").get<std::string>() != units[u].name ||
-          e.at("groups").get<std::vector<std::string>>() != units[u].groups ||
-          e.at("widths").get<std::vector<int64_t>>() != units[u].widths)
-        throw Error(context, "pattern pool unit " + std::to_string(u) + " (" + e.at("unit").get<std::string>() +
-                                 ") does not match the network's unit " + units[u].name);
-    }
     const auto& jp = j.at("patterns");
     if (!jp.is_array() || jp.empty()) throw Error(context, "the pattern pool has no pattern");
     for (size_t k = 0; k < jp.size(); ++k) {
-      std::map<std::string, int64_t> w;
-      for (const auto& u : units)
-        for (size_t i = 0; i < u.groups.size(); ++i) {
-          const auto c = jp[k].at(u.groups[i]).get<int64_t>();
-          if (c < 1 || c > u.widths[i])
-            throw Error(context, "pattern " + std::to_string(k) + " keeps " + std::to_string(c) + " channels of " +
-                                     u.groups[i] + ", which has " + std::to_string(u.widths[i]));
-          if (k > 0 && c > pool.widths.back().at(u.groups[i]))
-            throw Error(context, "pattern " + std::to_string(k) + " is wider than pattern " + std::to_string(k - 1) +
-                                     " in " + u.groups[i] + " (patterns are nested, widest first)");
-          w[u.groups[i]] = c;
-        }
-      pool.widths.push_back(std::move(w));
+      SubnetConfig p = subnet_from_json(jp[k], context + ": pattern " + std::to_string(k));
+      const auto problems = subnet_problems(spec, p);
+      if (!problems.empty())
+        throw Error(context, "pattern " + std::to_string(k) + " is not a subnet of the network: " + join(problems, "; "));
+      pool.patterns.push_back(std::move(p));
     }
   } catch (const nlohmann::json::exception& e) {
     throw Error(context, std::string("malformed pattern pool: ") + e.what());

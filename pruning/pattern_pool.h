@@ -1,74 +1,59 @@
 #pragma once
-// The pattern pool of a hybrid-pruned network: K nested patterns that differ in cost, from the
-// widest (k = 0) to the narrowest (k = K - 1). Pattern k keeps, of every layer group of every
-// pruning unit (prunable_units.h), the first widths[k][group] channels.
+// The pattern pool of a hybrid-pruned model: K subnets (models/subnet.h) of one network, widest
+// (slowest) first, that the dynamic pruning component chooses among per frame. They are points
+// of the search's Pareto front of an elastic network (pool_from_front), so every pattern is a
+// trained subnet and the pool spans latencies around the search's pick; they need not be nested,
+// and any of them may skip blocks. Each runs as views of the one network's weights.
 //
-// "The first channels" means something because the network's channels are reordered by
-// importance once (order_channels): channel 0 of a group matters most on the training frames.
-// A pattern's weights are then leading slices of the widest weights (views, no gather), a
-// narrower pattern keeps a subset of every wider one's channels, and the widest pattern is the
-// network itself: the static network that hybrid pruning ships is a pattern that was trained.
-//
-//   Inheritance ordered = order_channels(*net, units, importance);   // same outputs, sorted channels
-//   PatternPool pool = nested_pool(find_units(ordered.network->describe(false)), {1.0, 0.7, 0.5});
-//   graph::Graph narrow = select_channels(ordered.network->describe(false), pool.selection(2));
+//   PatternPool pool = pool_from_front(front, pick.score.latency_ms, options);   // elastic names
+//   SubnetConfig all = pool_union(pool);                  // what the static network keeps
+//   SRNetwork net = materialize_subnet(*elastic, all, false);
+//   PatternPool in_net = rebase_pool(pool, all, net->spec());                   // net's names
 
-#include <cstdint>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <torch/types.h>
-
 #include "core/config.h"
-#include "models/importance/channel_importance.h"
-#include "models/inherit.h"
-#include "models/sr_network.h"
-#include "models/channel_selection.h"
-#include "pruning/prunable_units.h"
+#include "models/arch_spec.h"
+#include "models/subnet.h"
+#include "search/strategy.h"
 
 namespace cgsr {
 
 struct PoolOptions {
-  // Pattern k keeps kept_count(width, keep_rates[k]) channels of every unit group. Strictly
-  // decreasing; the first is usually 1 (the static network keeps every channel it was given).
-  std::vector<double> keep_rates = {1.0, 0.75, 0.5, 0.35};
+  // Pattern k is the front point whose predicted latency is nearest latency_factors[k] times the
+  // pick's (each point once; fewer patterns when the front has fewer points).
+  std::vector<double> latency_factors = {1.5, 1.25, 1.0, 0.8, 0.65};
 };
 config::Schema<PoolOptions> pool_schema();
 
 struct PatternPool {
-  std::vector<PrunableUnit> units;                      // of the network the pool belongs to
-  std::vector<std::map<std::string, int64_t>> widths;   // [pattern][group] -> channels kept (a prefix)
+  ArchSpec spec;                      // the network the patterns are subnets of
+  std::vector<SubnetConfig> patterns;  // widest first
 
-  int size() const { return static_cast<int>(widths.size()); }
-  // The channels pattern k keeps: {group: 0, 1, ..., widths[k][group] - 1}.
-  ChannelSelection selection(int k) const;
-  // The fraction of the unit channels pattern k keeps (summed over groups).
+  int size() const { return static_cast<int>(patterns.size()); }
+  // The share of the network's channels pattern k keeps (skipped blocks keep none).
   double channel_fraction(int k) const;
 };
 
-// The pool of nested patterns over `units` (widest first); rates must be strictly decreasing in
-// (0, 1], and no two patterns may keep the same channels.
-PatternPool nested_pool(const std::vector<PrunableUnit>& units, const std::vector<double>& keep_rates);
+// The pool from a Pareto front (candidates fastest first) of subnets of `spec`, around the pick.
+PatternPool pool_from_front(const ArchSpec& spec, const std::vector<Candidate>& front, double pick_latency_ms,
+                            const PoolOptions& options);
 
-// The pool restricted to `kept` patterns (indices, increasing), in the network that keeps the
-// widest of them: what static pruning leaves when some patterns are never chosen.
-PatternPool keep_patterns(const PatternPool& pool, const std::vector<int>& kept,
-                          const std::vector<PrunableUnit>& narrowed_units);
+// The subnet holding every pattern: each group's widest width, every block some pattern keeps.
+SubnetConfig pool_union(const PatternPool& pool);
 
-// Per group of `units`: channel indices by decreasing importance, each frame's importance
-// normalized to sum 1 first so that every frame counts alike (ties: the lower index first).
-ChannelSelection importance_order(const std::vector<PrunableUnit>& units, const std::vector<FrameImportance>& frames);
+// The pool as subnets of the network `materialize_subnet(net, onto)` builds, whose spec is
+// `spec`: blocks renumbered in the order `onto` keeps them, their groups renamed with them.
+PatternPool rebase_pool(const PatternPool& pool, const SubnetConfig& onto, const ArchSpec& spec);
 
-// The same network with every unit group's channels permuted into `order` (a permutation per
-// group): it computes the same outputs (up to float summation order).
-Inheritance order_channels(const SRNetworkImpl& net, const ChannelSelection& order);
+// The patterns some frame chose (`counts[k]` > 0), in order; an Error when none was chosen.
+PatternPool chosen_patterns(const PatternPool& pool, const std::vector<int64_t>& counts, std::vector<int>& kept);
 
 nlohmann::ordered_json to_json(const PatternPool& pool);
-// `units` are those of the network the pool belongs to (find_units of its graph); the JSON must
-// match them. Errors name `context`.
-PatternPool pool_from_json(const nlohmann::ordered_json& j, const std::vector<PrunableUnit>& units,
-                           const std::string& context);
+// `spec` is the network the pool belongs to; every pattern must be a subnet of it. Errors name
+// `context`.
+PatternPool pool_from_json(const nlohmann::ordered_json& j, const ArchSpec& spec, const std::string& context);
 
 }  // namespace cgsr

@@ -60,20 +60,34 @@ std::vector<SubnetConfig> step_subnets(const ElasticSpace& space, const ElasticT
 
 TrainHooks elastic_training_hooks(SRNetwork network, const ElasticSpace& space, const ElasticTrainingOptions& options,
                                   LossOptions loss, int steps, uint64_t seed) {
+  return subnet_training_hooks(
+      network, [space, options, steps, seed](int step) { return step_subnets(space, options, step, steps, seed); },
+      options.distill, loss);
+}
+
+TrainHooks subnet_training_hooks(SRNetwork network, std::function<std::vector<SubnetConfig>(int step)> subnets,
+                                 double distill, LossOptions loss, SRNetwork teacher) {
+  if (teacher) {
+    teacher->eval();
+    for (auto& p : teacher->parameters()) p.set_requires_grad(false);
+  }
   TrainHooks hooks;
-  hooks.extra_loss = [network, space, options, loss, steps, seed](const Batch& batch, const TrainOutput& full,
-                                                                   int step) {
+  hooks.extra_loss = [network, subnets, distill, loss, teacher](const Batch& batch, const TrainOutput& full,
+                                                                 int step) mutable {
     torch::Tensor total = torch::zeros({}, batch.lr_color.options());
-    const auto subnets = step_subnets(space, options, step, steps, seed);
-    if (subnets.empty()) return total;
-    const torch::Tensor teacher = full.image.detach();
+    const auto chosen = subnets(step);
+    if (chosen.empty()) return total;
+    torch::Tensor target;
+    if (distill > 0) {
+      torch::NoGradGuard no_grad;
+      target = teacher ? teacher->forward(batch.lr_color, teacher->info_input(batch)) : full.image.detach();
+    }
     const torch::Tensor info = network->info_input(batch);
-    for (const auto& sub : subnets) {
+    for (const auto& sub : chosen) {
       const graph::Graph g = subnet_graph(*network, sub, /*training=*/false, /*differentiable=*/true);
       const torch::Tensor out = graph::run(g, network_inputs(g, batch.lr_color, info)).front().second;
-      if (options.distill > 0) total = total + options.distill * reconstruction_error(out, teacher, loss.image_norm);
-      if (options.distill < 1)
-        total = total + (1 - options.distill) * reconstruction_error(out, batch.hr_color, loss.image_norm);
+      if (distill > 0) total = total + distill * reconstruction_error(out, target, loss.image_norm);
+      if (distill < 1) total = total + (1 - distill) * reconstruction_error(out, batch.hr_color, loss.image_norm);
     }
     return total;
   };

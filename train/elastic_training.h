@@ -15,6 +15,8 @@
 //                   elastic_training_hooks(elastic.network, elastic.space, options, schedule.steps, seed));
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "core/config.h"
 #include "models/elastic.h"
@@ -53,5 +55,11 @@ std::vector<SubnetConfig> step_subnets(const ElasticSpace& space, const ElasticT
 // The trainer hooks: every step's extra loss is the sum of the step's subnets' losses.
 TrainHooks elastic_training_hooks(SRNetwork network, const ElasticSpace& space, const ElasticTrainingOptions& options,
                                   LossOptions loss, int steps, uint64_t seed);
+
+// The same for any choice of subnets per step (a pattern pool's, pruning/): each subnet's loss
+// is distill * ||subnet - target|| + (1 - distill) * ||subnet - HR||, the target the output of
+// `teacher` when given (run without gradients), else the network's own output of the step.
+TrainHooks subnet_training_hooks(SRNetwork network, std::function<std::vector<SubnetConfig>(int step)> subnets,
+                                 double distill, LossOptions loss, SRNetwork teacher = nullptr);
 
 }  // namespace cgsr

@@ -33,7 +33,7 @@ HybridModel make_hybrid(const std::vector<std::string>& channels, int grid, uint
   test::randomize(*net);
   net->eval();
   HybridModel h;
-  h.pool = nested_pool(find_units(net->describe(false)), {1.0, 0.6, 0.3});
+  h.pool = test::random_pool(*net, 3, seed);
   SamplerOptions so;
   so.channels = channels;
   so.grid = grid;

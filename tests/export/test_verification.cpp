@@ -12,7 +12,7 @@
 #include "export/exporter.h"
 #include "export/verification.h"
 #include "models/inherit.h"
-#include "pruning/baseline_pruning.h"
+#include "pruning/equal_latency_controls.h"
 #include "models/elastic.h"
 #include "models/subnet.h"
 #include "tests/export/export_cases.h"
@@ -74,7 +74,7 @@ TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
   while (searched.blocks.size() == static_cast<size_t>(space.total_blocks())) searched = space.sample(rng);
   const std::vector<std::pair<std::string, SRNetwork>> nets = {
       {"searched", materialize_subnet(*parent, searched)},
-      {"magnitude_pruned", magnitude_prune(*parent, 0.5).network},
+      {"magnitude_pruned", materialize_subnet(*parent, control_subnet(*parent, ControlKind::Magnitude, 0.5))},
   };
   std::vector<VerifyCase> cases;
   for (auto [name, net] : nets) {

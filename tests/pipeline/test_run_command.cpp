@@ -43,12 +43,10 @@ search:
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 scratch: {steps: 3}
 prune:
-  pool_frames: 2
-  pool: {keep_rates: [1.0, 0.5]}
+  pool: {latency_factors: [1.2, 1.0, 0.8]}
   sampler: {grid: 4, width: 2}
   selector: {steps: 2, latency_runs: 1}
   finetune:
-    epochs: 0
     schedule: {steps: 2, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1}
 eval: {max_frames: 2, latency_runs: 1}
 heldout: {scenes: [HELDOUT], frames: 2}
@@ -136,7 +134,7 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   const std::string report = slurp(out / "report" / "report.md");
   for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2",
                                 "elastic CG-enhanced PAN x2", "CG-optimized PAN x2", "CG-optimized PAN x2 (scratch)",
-                                "CG-enhanced PAN x2 MMP", "CG-enhanced PAN x2 uniform width", "CG-optimized PAN x2 MMP",
+                                "CG-enhanced PAN x2 MMP", "CG-enhanced PAN x2 uniform width",
                                 "CG-optimized PAN x2 hybrid"})
     EXPECT_NE(report.find("| " + row + " "), std::string::npos) << row << "\n" << report;
   const auto results = read_json(out / "results.json");
@@ -151,7 +149,7 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   const size_t section = report.find("## Held-out scene: tiny-heldout");
   ASSERT_NE(section, std::string::npos) << report;
   for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2", "CG-optimized PAN x2",
-                                "CG-optimized PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
+                                "CG-optimized PAN x2 (scratch)", "CG-enhanced PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
     EXPECT_NE(report.find("| " + row + " ", section), std::string::npos) << row << "\n" << report;
   int heldout_checks = 0;
   for (const auto& check : results["verdict"]["checks"])
@@ -195,9 +193,10 @@ TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   EXPECT_NE(typo.err.find("train.schedule.stepz: unknown key 'stepz' (did you mean 'steps'?)"), std::string::npos)
       << typo.err;
   // A mistake in the last stage's section stops the run before the first stage renders anything.
-  const CliResult late = run_cgsr(base + " --set prune.pool.keep_rates=[7]");
+  const CliResult late = run_cgsr(base + " --set prune.pool.latency_factors=[1,2]");
   EXPECT_EQ(late.exit_code, 2);
-  EXPECT_NE(late.err.find("prune.pool.keep_rates: must be strictly decreasing"), std::string::npos) << late.err;
+  EXPECT_NE(late.err.find("prune.pool.latency_factors: must be positive and strictly decreasing"), std::string::npos)
+      << late.err;
   EXPECT_FALSE(fs::exists(dir / "run" / "data" / "manifest.yaml"));
 
   const CliResult filled = run_cgsr(base + " --set search.model=x.cgsr");

@@ -1,15 +1,21 @@
 #pragma once
 // Shared fixtures of the pruning tests: small networks of every backbone (with and without a
-// RIT, pixel-shuffle and attention groups included), random weights, random channel orders, and
-// the masked dense reference computation a pattern's execution must equal.
+// RIT, pixel-shuffle and attention groups included), random weights, random pattern pools, and
+// what a pattern computes through the graph interpreter.
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "models/arch_spec.h"
+#include "models/channel_selection.h"
+#include "models/complexity.h"
+#include "models/elastic.h"
+#include "models/subnet.h"
 #include "models/sr_network.h"
 #include "pruning/pattern_pool.h"
 #include "pruning/prunable_units.h"
@@ -64,23 +70,35 @@ inline std::pair<torch::Tensor, torch::Tensor> inputs_for(const SRNetworkImpl& n
   return {color, info};
 }
 
-// A random permutation of every unit group's channels (what order_channels takes).
-inline ChannelSelection random_order(const std::vector<PrunableUnit>& units, uint32_t seed) {
-  std::mt19937 rng(seed);
-  ChannelSelection order;
-  for (const auto& u : units)
-    for (size_t g = 0; g < u.groups.size(); ++g) {
-      std::vector<int64_t> all(u.widths[g]);
-      for (int64_t c = 0; c < u.widths[g]; ++c) all[c] = c;
-      std::shuffle(all.begin(), all.end(), rng);
-      order[u.groups[g]] = all;
-    }
-  return order;
+// `k` random subnets of `net` (quantum 2, at least one block), widest (most MACs) first.
+inline PatternPool random_pool(const SRNetworkImpl& net, int k, uint64_t seed) {
+  const ElasticSpace space(net.spec(), ElasticOptions{2, 0.25, 1});
+  std::mt19937_64 rng(seed);
+  std::vector<std::pair<int64_t, SubnetConfig>> drawn;
+  std::set<std::string> keys;
+  while (static_cast<int>(drawn.size()) < k) {
+    SubnetConfig sub = space.sample(rng);
+    if (!keys.insert(subnet_key(sub)).second) continue;
+    drawn.emplace_back(complexity(subnet_graph(net, sub), 16, 12).macs, sub);
+  }
+  std::stable_sort(drawn.begin(), drawn.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  PatternPool pool;
+  pool.spec = net.spec();
+  for (auto& [macs, sub] : drawn) pool.patterns.push_back(sub);
+  return pool;
 }
 
-// The reference: the dense network with every convolution's input columns of removed channels
-// set to zero (a copy of the weights), run by the graph interpreter. Removing a channel of a
-// pruning unit can only act through the convolutions reading it.
+// What pattern k of `pool` computes on `net` (the graph interpreter).
+inline torch::Tensor run_pattern(const SRNetworkImpl& net, const PatternPool& pool, int k, const torch::Tensor& color,
+                                 const torch::Tensor& info) {
+  torch::NoGradGuard no_grad;
+  const graph::Graph g = subnet_graph(net, pool.patterns.at(k));
+  return graph::run(g, network_inputs(g, color, info)).front().second;
+}
+
+// The reference of a channel selection: the dense network with every convolution's input columns
+// of removed channels set to zero (a copy of the weights), run by the graph interpreter.
+// Removing a channel of a pruning unit can only act through the convolutions reading it.
 inline torch::Tensor masked_dense(const SRNetworkImpl& net, const ChannelSelection& keep, const torch::Tensor& color,
                                   const torch::Tensor& info) {
   torch::NoGradGuard no_grad;

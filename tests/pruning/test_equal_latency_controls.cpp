@@ -1,0 +1,42 @@
+// The controls of equal latency: magnitude pruning narrows the pruning units alone, uniform width
+// every group; both keep the channels of largest magnitude, and the rate is found for a latency.
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "models/importance/channel_importance.h"
+#include "pruning/equal_latency_controls.h"
+#include "pruning/prunable_units.h"
+#include "tests/pruning/pruning_cases.h"
+
+using namespace cgsr;
+using namespace cgsr::test;
+
+TEST(EqualLatencyControls, MagnitudeNarrowsTheUnitsUniformEveryGroup) {
+  SRNetwork net(small_spec("pan", 2, 2, 8, 8, /*rit=*/true));
+  const auto mmp = control_subnet(*net, ControlKind::Magnitude, 0.5);
+  const auto uniform = control_subnet(*net, ControlKind::Uniform, 0.5);
+  EXPECT_EQ(mmp.widths.at("features"), 8);  // the residual stream stays whole
+  EXPECT_EQ(mmp.widths.at("block0_a"), 4);
+  EXPECT_EQ(uniform.widths.at("features"), 4);
+  EXPECT_EQ(uniform.widths.at("rit"), 3);  // round(0.5 x 5)
+  EXPECT_EQ(mmp.blocks.size(), 2u);
+  EXPECT_THROW(control_subnet(*net, ControlKind::Uniform, 0), Error);
+  EXPECT_EQ(control_label(ControlKind::Magnitude), "MMP");
+}
+
+TEST(EqualLatencyControls, KeepTheLargestChannelsAndMatchALatency) {
+  torch::manual_seed(31);
+  SRNetwork net(small_spec("pan", 2, 2, 8, 8, /*rit=*/true));
+  randomize(*net);
+  net->eval();
+  const ControlNetwork half = control_at_rate(*net, ControlKind::Magnitude, 0.5, 32, 24);
+  // Its first block's `a` group holds the 4 channels of largest L1 magnitude, largest first.
+  const auto full = channel_importance(*net).at("block0_a").detach();
+  const auto kept = channel_importance(*half.network).at("block0_a").detach();
+  const auto top = std::get<0>(full.sort(0, /*descending=*/true)).slice(0, 0, 4);
+  EXPECT_TRUE(torch::allclose(kept, top, 1e-5, 1e-6));
+  EXPECT_GT(half.latency_ms, 0);
+  const ControlNetwork matched = control_at_latency(*net, ControlKind::Uniform, half.latency_ms, 32, 24);
+  EXPECT_LE(matched.latency_ms, half.latency_ms * 1.5);  // measured: a noisy machine may wobble
+  EXPECT_LT(matched.rate, 1.0);
+}
