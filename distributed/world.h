@@ -4,7 +4,7 @@
 // (c10d::TCPStore), and average tensors over a Gloo process group (c10d::ProcessGroupGloo).
 //
 //   auto world = World::join(options);       // every rank; returns when all N have joined
-//   world->store().set("key", "value");      // small messages and work claims (work_queue.h)
+//   world->store().set("key", "value");      // small messages (the training's layout, resume state)
 //   world->allreduce_mean(gradients);        // collectives (data-parallel training)
 //
 // Every rank beats a heartbeat counter in the store once a second from a thread of its own, so

@@ -85,7 +85,7 @@ class ElasticSpace {
 
 // An elastic network ready to train: the network with every layer group's channels sorted by
 // importance (it computes the same outputs, up to float summation order) and its space, the
-// blocks ranked by importance (block_importance.h).
+// blocks ranked by importance (importance/block_importance.h).
 struct ElasticNetwork {
   SRNetwork network{nullptr};
   ElasticSpace space;

@@ -7,7 +7,7 @@
 // from every layer writing into or reading from it, both operands of an attention product lose
 // the same channels, and a pixel-shuffle group keeps or drops all r*r sub-channels together.
 // Block i of the child inherits block i of the parent (a child may have fewer blocks), or the
-// parent block the caller names (importance/block_importance.h: the search drops the least important).
+// parent block the caller names (a subnet's kept blocks, subnet.h).
 //
 // Parts the parent lacks start fresh: a RIT (its fusion is zero, so the output equals the
 // parent's exactly) and the geometry head. The child's RIT may read a subset of the parent's

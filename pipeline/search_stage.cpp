@@ -28,7 +28,7 @@ config::Schema<PickOptions> pick_schema() {
 
 config::Schema<FinalTraining> final_schema() {
   config::Schema<FinalTraining> s;
-  s.section("schedule", &FinalTraining::schedule, schedule_schema(), "fine-tuning of the pick (steps: 0 for none)");
+  s.section("schedule", &FinalTraining::schedule, schedule_schema(), "fine-tuning of the pick");
   s.section("loss", &FinalTraining::loss, loss_schema(), "its loss");
   s.field("distill", &FinalTraining::distill, "weight of the full network's output beside the HR frame's").range(0, 100);
   return s;
@@ -147,15 +147,12 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   provenance.extra = {{"name", name}, {"data", data.info().root.string()}, {"subnet", to_json(pick.subnet)}};
   save_model(run_dir.file("subnet.cgsr"), *picked, provenance);
   save_spec_file(run_dir.file("pick_spec.yaml"), picked->spec());  // what the scratch control trains
-  std::optional<TrainOutcome> final_training;
-  if (options.final.schedule.steps > 0) {
-    TrainHooks hooks;
-    if (options.final.distill > 0)
-      hooks = distillation_hooks(elastic.network, options.final.distill, options.final.loss.image_norm);
-    Trainer trainer(picked, data, options.final.schedule, options.final.loss, {}, hooks);
-    final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
-    provenance.metrics = {{"val_psnr", final_training->best.psnr}, {"val_ssim", final_training->best.ssim}};
-  }
+  TrainHooks hooks;
+  if (options.final.distill > 0)
+    hooks = distillation_hooks(elastic.network, options.final.distill, options.final.loss.image_norm);
+  Trainer trainer(picked, data, options.final.schedule, options.final.loss, {}, hooks);
+  const TrainOutcome final_training = trainer.run(run_dir.file("final_checkpoint.pt"), options.resume);
+  provenance.metrics = {{"val_psnr", final_training.best.psnr}, {"val_ssim", final_training.best.ssim}};
   save_model(run_dir.file("model.cgsr"), *picked, provenance);
 
   nlohmann::ordered_json j;
@@ -188,7 +185,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   j["pick"]["budget_ms"] = budget;
   j["pick"]["spec"] = spec_summary(picked->spec());
   j["pick"]["params"] = inference_parameter_count(*picked);
-  if (final_training) j["final_training"] = to_json(*final_training);
+  j["final_training"] = to_json(final_training);
   return j;
 }
 

@@ -25,7 +25,7 @@ struct PickOptions {
 };
 
 struct FinalTraining {
-  TrainSchedule schedule;  // fine-tuning of the pick (0 steps: none)
+  TrainSchedule schedule;  // fine-tuning of the pick
   LossOptions loss;
   double distill = 1.0;    // weight of the full network's output beside the HR frame's 1
 };

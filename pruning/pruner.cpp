@@ -18,7 +18,7 @@ namespace cgsr {
 
 config::Schema<PoolTraining> pool_training_schema() {
   config::Schema<PoolTraining> s;
-  s.section("schedule", &PoolTraining::schedule, schedule_schema(), "optimization schedule (steps 0: none)");
+  s.section("schedule", &PoolTraining::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &PoolTraining::loss, loss_schema(), "its loss");
   s.field("distill", &PoolTraining::distill, "weight of the full elastic network's output beside the HR frame's")
       .range(0, 1);
@@ -121,7 +121,7 @@ nlohmann::ordered_json prune(const std::filesystem::path& elastic_path, const st
                name, pool.size(), table.predict(subnet_graph(*elastic.network, pool.patterns.front())),
                table.predict(subnet_graph(*elastic.network, pool.patterns.back())), search.pick.score.latency_ms);
   nlohmann::ordered_json results;
-  if (options.finetune.schedule.steps > 0) {
+  {
     const auto patterns = in_net.patterns;
     Trainer trainer(net, data, options.finetune.schedule, options.finetune.loss, {},
                     subnet_training_hooks(

@@ -4,8 +4,7 @@
 //   1. the pattern pool: points of the search's Pareto front around its pick (pattern_pool.h),
 //      all subnets of one elastic network, some wider and some narrower than the pick
 //   2. the network that holds them (their union) with every pattern fine-tuned at once,
-//      distilled from the full elastic network, for as many steps as the pick was (0: the
-//      patterns as the elastic network holds them)
+//      distilled from the full elastic network, for as many steps as the pick was
 //   3. the dynamic pruning component fitted to choose, per frame, the cheapest pattern that does
 //      not cost the frame quality, on average at the pick's predicted latency (dynamic_pruning.h)
 //   4. static pruning of the patterns no training frame selects (static_pruning.h), and the
@@ -37,7 +36,7 @@ namespace cgsr {
 
 // The fine-tuning of every pattern at once (the search's fine-tuning of the pick, for the pool).
 struct PoolTraining {
-  TrainSchedule schedule;  // steps 0: no fine-tuning
+  TrainSchedule schedule;
   LossOptions loss;
   double distill = 1.0;    // weight of the full elastic network's output beside the HR frame's
 };

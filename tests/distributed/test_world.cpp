@@ -10,7 +10,6 @@
 #include <set>
 
 #include "core/error.h"
-#include "distributed/work_queue.h"
 #include "distributed/world.h"
 #include "tests/support/free_port.h"
 
@@ -81,62 +80,6 @@ TEST(World, RanksMeetAverageGatherAndBroadcast) {
   }
   EXPECT_EQ(std::get<2>(results[0]), (std::vector<std::string>{"x", "xx", "xxx"}));
   EXPECT_TRUE(std::get<2>(results[1]).empty());
-}
-
-TEST(WorkQueue, EveryTaskRunsAndResultsArriveInTaskOrder) {
-  const auto results = on_ranks(2, [](World& world) {
-    WorkQueue queue(world);
-    const auto square = [&](size_t, const std::string& task) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(30));  // long enough for both ranks to claim
-      return std::to_string(std::stoi(task) * std::stoi(task));
-    };
-    std::vector<std::string> done;
-    int ran = 0;
-    if (world.coordinator()) {
-      for (int batch = 0; batch < 2; ++batch) {
-        std::vector<std::string> tasks;
-        for (int i = 0; i < 8; ++i) tasks.push_back(std::to_string(batch * 10 + i));
-        size_t expected = 0;
-        queue.run_batch(tasks, square, [&](size_t index, const std::string& result) {
-          EXPECT_EQ(index, expected++);
-          done.push_back(result);
-        });
-      }
-      queue.finish();
-    } else {
-      ran = queue.serve(square);
-    }
-    return std::make_pair(done, ran);
-  });
-  std::vector<std::string> expected;
-  for (int batch = 0; batch < 2; ++batch)
-    for (int i = 0; i < 8; ++i) expected.push_back(std::to_string((batch * 10 + i) * (batch * 10 + i)));
-  EXPECT_EQ(results[0].first, expected);
-  EXPECT_GT(results[1].second, 0);  // rank 1 took part
-  EXPECT_LT(results[1].second, 16);
-}
-
-TEST(WorkQueue, ATaskThatFailsOnAnotherRankFailsTheBatchNamingTheRank) {
-  const auto results = on_ranks(2, [](World& world) {
-    WorkQueue queue(world);
-    std::string error;
-    try {
-      if (world.coordinator()) {
-        queue.run_batch({"a", "b", "c", "d"}, [](size_t, const std::string&) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(300));
-          return std::string("ok");
-        }, [](size_t, const std::string&) {});
-      } else {
-        queue.serve([](size_t, const std::string& task) -> std::string { throw Error("task " + task, "no luck"); });
-      }
-    } catch (const Error& e) {
-      error = e.what();
-    }
-    return error;
-  });
-  EXPECT_NE(results[0].find("rank 1"), std::string::npos) << results[0];
-  EXPECT_NE(results[0].find("no luck"), std::string::npos) << results[0];
-  EXPECT_NE(results[1].find("no luck"), std::string::npos) << results[1];
 }
 
 TEST(World, ClearErrorsForBadRanksBusyPortsAndMissingPeers) {

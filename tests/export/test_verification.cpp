@@ -9,12 +9,17 @@
 #include <random>
 #include <set>
 
+#include "core/runtime.h"
 #include "export/exporter.h"
 #include "export/verification.h"
-#include "models/inherit.h"
-#include "pruning/equal_latency_controls.h"
 #include "models/elastic.h"
+#include "models/inherit.h"
+#include "models/latency_table.h"
 #include "models/subnet.h"
+#include "pruning/equal_latency_controls.h"
+#include "search/search_loop.h"
+#include "search/subnet_evaluator.h"
+#include "tests/support/tiny_data.h"
 #include "tests/export/export_cases.h"
 #include "tests/support/cli_runner.h"
 
@@ -91,6 +96,49 @@ TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
   const VerifyReport report = verify_exports(cases);
   EXPECT_EQ(report.checks.size(), 8u);  // 2 networks x 2 formats x 2 runtimes
   EXPECT_EQ(report.passed(), 8) << report.table();
+  std::filesystem::remove_all(dir);
+}
+
+// Every subnet on a search's front (an elastic network scored on rendered crops) materializes
+// as a network of its own that exports to ONNX and computes in ONNX Runtime what cgsr computes.
+TEST(Verification, EverySubnetOnASearchFrontExportsAndMatchesInOnnxRuntime) {
+  const auto dir = test::scratch_dir("export-verify-front");
+  seed_everything(9);
+  const Dataset data = Dataset::open(test::tiny_data());
+  SRNetwork net = test::build_network(test::with_rit(default_spec("pan", 2), "hr_unshuffle+hr_fuse", "concat"), 600);
+  const ElasticNetwork elastic = make_elastic(*net, ElasticOptions{8, 0.25, 4});
+  LatencyTableOptions latency;
+  latency.runs = 1;
+  latency.calibration_subnets = 2;
+  latency.check_subnets = 0;
+  latency.subnet_runs = 1;
+  ValidationCropOptions crops;
+  crops.frames = 1;
+  crops.size = 16;
+  InferenceEvaluator evaluator(elastic.network, data, crops,
+                               measure_latency_table(*elastic.network, elastic.space, 32, 24, latency));
+  SearchOptions options;
+  options.population = 8;
+  options.generations = 2;
+  SearchHistory history(dir / "history.jsonl", false);
+  const SearchResult result = run_search(elastic.space, evaluator, history, options, "evolution");
+  ASSERT_GE(result.front.size(), 2u);
+  std::vector<VerifyCase> cases;
+  for (size_t i = 0; i < result.front.size(); ++i) {
+    SRNetwork subnet = materialize_subnet(*elastic.network, result.front[i].subnet);
+    subnet->eval();
+    ExportOptions o;
+    o.format = ExportFormat::Onnx;
+    o.width = kWidth;
+    o.height = kHeight;
+    const auto m = export_network(*subnet, dir / ("front_" + std::to_string(i) + ".onnx"), o);
+    cases.push_back(make_verify_case(*subnet, m, {{kWidth, kHeight}}, 11));
+  }
+  const VerifyReport report = verify_exports(cases);
+  int onnxruntime = 0;
+  for (const auto& check : report.checks) onnxruntime += check.runtime == Runtime::OnnxRuntime && check.passed;
+  EXPECT_EQ(onnxruntime, static_cast<int>(result.front.size())) << report.table();
+  EXPECT_TRUE(report.ok()) << report.table();
   std::filesystem::remove_all(dir);
 }
 

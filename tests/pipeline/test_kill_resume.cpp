@@ -93,6 +93,22 @@ fs::path train_cg_parent(const fs::path& dir, const fs::path& data) {
   return out / "model.cgsr";
 }
 
+// A CG-enhanced network trained briefly as an elastic network, with its latency table.
+fs::path train_elastic(const fs::path& dir, const fs::path& data) {
+  const auto parent = train_cg_parent(dir, data);
+  const auto out = dir / "elastic";
+  const auto r = run_cgsr_args(
+      with_run_flags({"train", "--data", data.string(), "--model", parent.string(), "--set", "elastic.enabled=true",
+                      "--set", "elastic.space={quantum: 2, min_width_fraction: 0.25, min_blocks: 1}", "--set",
+                      "elastic.latency={runs: 1, calibration_subnets: 2, check_subnets: 1, subnet_runs: 1}",
+                      "--steps", "10", "--set", "schedule.batch_size=2", "--set", "schedule.patch_size=16", "--set",
+                      "schedule.validate_every=0", "--set", "schedule.val_frames=1"},
+                     out),
+      dir / "elastic");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return out / "model.cgsr";
+}
+
 // What a killed run may leave: never results.json or a log.txt that looks complete; a model file
 // only when it is whole. Its log.txt.partial holds the log up to the kill (`logged`: a line the
 // run wrote well before it was killed), which is what tells a user how far the run got.
@@ -190,46 +206,44 @@ TEST(KillResume, TrainResumesFromItsCheckpointToTheUninterruptedResult) {
 TEST(KillResume, SearchResumedTwiceMakesTheUninterruptedPick) {
   const auto dir = scratch_dir("kill-resume-search");
   const auto data = render_tiny(dir);
-  const auto parent = train_cg_parent(dir, data);
-  // 1 parent + 2 generations of 3 candidates: 7 history lines; every candidate trains 60 steps.
+  const auto elastic = train_elastic(dir, data);
+  // 6 generations of 30 subnets, scored on 8 crops: long enough to be killed between generations.
   const auto config = dir / "search.yaml";
-  std::ofstream(config) << R"(population: 3
-selection_ratio: 0.34
-generations: 2
-min_candidates: 1
-tolerance_db: 0.5
-candidate:
-  schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 0, val_frames: 1, layout: nhwc}
-final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5, layout: nhwc}
+  std::ofstream(config) << R"(population: 30
+generations: 6
+baseline: ""
+crops: {frames: 2, crops_per_frame: 4, size: 24, margin: 4}
+pick: {latency_fraction: 0.6}
+final:
+  schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5, layout: nhwc}
 )";
-  const std::vector<std::string> search = {"search", "--config", config.string(), "--parent", parent.string(),
+  const std::vector<std::string> search = {"search", "--config", config.string(), "--model", elastic.string(),
                                            "--data", data.string()};
   const auto reference = dir / "reference", out = dir / "run";
   auto r = run_cgsr_args(with_run_flags(search, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  ASSERT_EQ(line_count(reference / "history.jsonl"), 7);
+  ASSERT_EQ(line_count(reference / "history.jsonl"), 180);
 
   const auto resume = with_resume(with_run_flags(search, out));
-  // Killed during the candidates (after the parent and one candidate are recorded) ...
+  // Killed during the search (after its first generation is recorded) ...
   ASSERT_NO_FATAL_FAILURE(kill_when(with_run_flags(search, out), dir / "killed1",
-                                    [&] { return line_count(out / "history.jsonl") >= 2; }));
-  expect_killed_run_dir(out, {"model.cgsr"}, "] search: parent ");
-  EXPECT_LT(line_count(out / "history.jsonl"), 7);
+                                    [&] { return line_count(out / "history.jsonl") >= 30; }));
+  expect_killed_run_dir(out, {"model.cgsr", "subnet.cgsr"}, "] search: ");
+  EXPECT_LT(line_count(out / "history.jsonl"), 180);
   ASSERT_FALSE(fs::exists(out / "final_checkpoint.pt"));  // the next kill waits for it
-  // ... then, resumed, killed again during the training of the pick ...
+  // ... then, resumed, killed again during the fine-tuning of the pick ...
   ASSERT_NO_FATAL_FAILURE(
       kill_when(resume, dir / "killed2", [&] { return fs::exists(out / "final_checkpoint.pt"); }));
-  expect_killed_run_dir(out, {"model.cgsr"}, "] generation 1: ");
-  EXPECT_EQ(line_count(out / "history.jsonl"), 7);
+  expect_killed_run_dir(out, {"model.cgsr"}, "] search: pick ");
+  EXPECT_EQ(line_count(out / "history.jsonl"), 180);
   // ... and resumed to the end.
   r = run_cgsr_args(resume, dir / "resumed");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_GT(resumed_at(r.err), 0) << r.err;
   expect_finished_run_dir(out);
 
-  // Every history line is a whole JSON object, each candidate once, and the same candidates with
-  // the same scores as the uninterrupted search (a candidate evaluated twice, or trained
-  // differently after the resume, would show here).
+  // Every history line is a whole JSON object, each subnet once, and the same subnets with the
+  // same scores as the uninterrupted search (a subnet scored twice would show here).
   std::vector<nlohmann::json> expected_lines, lines;
   {
     std::ifstream a(reference / "history.jsonl"), b(out / "history.jsonl");
@@ -241,21 +255,15 @@ final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames
   ASSERT_EQ(lines.size(), expected_lines.size());
   std::set<std::string> keys;
   for (size_t i = 0; i < lines.size(); ++i) {
-    EXPECT_TRUE(keys.insert(lines[i]["key"].get<std::string>()).second)
-        << "candidate recorded twice: " << lines[i]["summary"];
+    EXPECT_TRUE(keys.insert(lines[i]["key"].get<std::string>()).second) << "subnet recorded twice: " << lines[i]["key"];
     EXPECT_EQ(lines[i]["key"], expected_lines[i]["key"]) << i;
-    EXPECT_EQ(lines[i]["generation"], expected_lines[i]["generation"]) << i;
-    EXPECT_EQ(lines[i]["score"]["val_psnr"], expected_lines[i]["score"]["val_psnr"]) << i;
-    EXPECT_EQ(lines[i]["score"]["params"], expected_lines[i]["score"]["params"]) << i;
+    EXPECT_EQ(lines[i]["score"], expected_lines[i]["score"]) << i;
   }
 
   const auto expected = read_json(reference / "results.json"), got = read_json(out / "results.json");
-  EXPECT_EQ(expected["pick"]["is_parent"], false);  // a candidate won: the comparison means something
-  EXPECT_EQ(got["pick"]["spec_yaml"], expected["pick"]["spec_yaml"]);
-  EXPECT_EQ(got["pick"]["score"]["val_psnr"], expected["pick"]["score"]["val_psnr"]);
-  EXPECT_EQ(got["pick"]["is_parent"], expected["pick"]["is_parent"]);
-  EXPECT_EQ(got["candidates"], 6);
-  EXPECT_EQ(got["generations"], 2);
+  EXPECT_EQ(got["pick"]["key"], expected["pick"]["key"]);
+  EXPECT_EQ(got["searches"]["evolution"]["hypervolume"], expected["searches"]["evolution"]["hypervolume"]);
+  EXPECT_EQ(got["searches"]["evolution"]["evaluations"], 180);
   EXPECT_EQ(got["final_training"]["steps"], 60);
   EXPECT_EQ(got["final_training"]["resumed"], true);
   EXPECT_EQ(history_psnrs(got["final_training"]), history_psnrs(expected["final_training"]));
@@ -267,20 +275,31 @@ final: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames
 TEST(KillResume, PruneResumesItsFineTuning) {
   const auto dir = scratch_dir("kill-resume-prune");
   const auto data = render_tiny(dir);
-  const auto model = train_cg_parent(dir, data);
+  const auto elastic = train_elastic(dir, data);
+  const auto searched = dir / "search";
+  auto searched_run = run_cgsr_args(
+      with_run_flags({"search", "--model", elastic.string(), "--data", data.string(), "--set", "population=8", "--set",
+                      "generations=2", "--set", "crops.frames=1", "--set", "crops.size=16", "--set",
+                      "pick.latency_fraction=0.6", "--set", "final.schedule.steps=1", "--set",
+                      "final.schedule.batch_size=2", "--set", "final.schedule.patch_size=16", "--set",
+                      "final.schedule.val_frames=1"},
+                     searched),
+      dir / "search");
+  ASSERT_EQ(searched_run.exit_code, 0) << searched_run.err;
   // configs/prune/quick.yaml, smaller still: fine-tuning of 60 steps, a checkpoint every 5.
   const std::vector<std::string> prune = {
-      "prune", "--config", std::string(CGSR_SOURCE_DIR) + "/configs/prune/quick.yaml", "--model", model.string(),
-      "--data", data.string(), "--set", "selector.steps=5", "--set", "finetune.schedule.steps=60", "--set",
-      "finetune.schedule.checkpoint_every=5", "--set", "finetune.schedule.batch_size=2", "--set",
-      "finetune.schedule.patch_size=16", "--set", "finetune.schedule.layout=nhwc", "--set", "eval.latency_runs=0"};
+      "prune", "--config", std::string(CGSR_SOURCE_DIR) + "/configs/prune/quick.yaml", "--model", elastic.string(),
+      "--search", (searched / "results.json").string(), "--data", data.string(), "--set", "selector.steps=5", "--set",
+      "finetune.schedule.steps=60", "--set", "finetune.schedule.checkpoint_every=5", "--set",
+      "finetune.schedule.batch_size=2", "--set", "finetune.schedule.patch_size=16", "--set",
+      "finetune.schedule.layout=nhwc", "--set", "eval.latency_runs=0"};
   const auto reference = dir / "reference", out = dir / "run";
   auto r = run_cgsr_args(with_run_flags(prune, reference), dir / "reference");
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
   ASSERT_NO_FATAL_FAILURE(
-      kill_when(with_run_flags(prune, out), dir / "killed", [&] { return fs::exists(out / "finetune_hybrid.pt"); }));
-  expect_killed_run_dir(out, {"pruned.cgsr", "baseline0_magnitude.cgsr"}, "] fine-tuning 3 nested patterns");
+      kill_when(with_run_flags(prune, out), dir / "killed", [&] { return fs::exists(out / "finetune_patterns.pt"); }));
+  expect_killed_run_dir(out, {"pruned.cgsr"}, "] pruning around ");
 
   r = run_cgsr_args(with_resume(with_run_flags(prune, out)), dir / "resumed");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -295,8 +314,8 @@ TEST(KillResume, PruneResumesItsFineTuning) {
   EXPECT_NO_THROW(load_hybrid_model(out / "pruned.cgsr"));
   expect_same_weights(reference / "pruned.cgsr", out / "pruned.cgsr");
   const auto expected = read_json(reference / "results.json"), got = read_json(out / "results.json");
-  EXPECT_EQ(got["finetune"]["hybrid"]["resumed"], true);
-  EXPECT_EQ(got["finetune"]["hybrid"]["steps"], 60);
+  EXPECT_EQ(got["finetune"]["resumed"], true);
+  EXPECT_EQ(got["finetune"]["steps"], 60);
   EXPECT_EQ(got["pruned_spec"], expected["pruned_spec"]);
   ASSERT_EQ(got["evaluations"].size(), expected["evaluations"].size());
   for (size_t i = 0; i < got["evaluations"].size(); ++i) {

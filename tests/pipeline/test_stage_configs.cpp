@@ -1,10 +1,9 @@
 // The shapes of the stage configs of `cgsr run`: the search options at the top of a search
-// config, the enhance stage's rit and geometry at its top, the older nested shapes still read,
-// and the search stage's cache form (the shape its stage hash has always been made of).
+// config, the enhance stage's rit and geometry and the elastic stage's keys at their tops, and
+// the older nested enhance block still read.
 #include <gtest/gtest.h>
 
 #include "core/config.h"
-#include "pipeline/distributed_run.h"
 #include "pipeline/search_stage.h"
 #include "pipeline/train_stage.h"
 
@@ -14,11 +13,6 @@ namespace {
 template <class T>
 T parse(const std::string& yaml, const config::Schema<T>& schema) {
   return config::parse_document(config::Document::parse(yaml, "stage.yaml"), schema);
-}
-std::vector<std::string> keys_of(const YAML::Node& map) {
-  std::vector<std::string> keys;
-  for (const auto& kv : map) keys.push_back(kv.first.Scalar());
-  return keys;
 }
 }  // namespace
 
