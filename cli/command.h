@@ -13,6 +13,7 @@
 
 #include "core/config.h"
 #include "core/run_dir.h"
+#include "models/memory_layout.h"
 #include "pipeline/run_settings.h"
 
 namespace cgsr::cli {
@@ -47,7 +48,7 @@ void begin_command(const RunSettings& run);
 // Registers `name` as a subcommand that parses its options with `schema` and runs `body`.
 // `flags` registers the command's own CLI flags; each flag appends assignments to the vector.
 // The run directory exists when --out is given, or always when `always_run_dir` is true
-// (default runs/<name>-<time>). `body` gets the options, the resolved config and the run
+// (default runs/<name>-<time>); it records the memory layouts the command chose (layouts.json). `body` gets the options, the resolved config and the run
 // directory, and returns the results written to results.json. `place_run_dir`, when given, moves
 // the run directory (e.g. a distributed rank's own subdirectory). `check`, when given, is what
 // --check does beyond parsing the options (e.g. cgsr run parses every stage's section), and
@@ -85,6 +86,9 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
       run_dir = std::make_unique<RunDir>(dir);
     }
     if (run_dir) run_dir->write_config(resolved);
+    // The memory layouts `auto` chose, so that a rerun of the directory uses them (memory_layout.h).
+    std::optional<LayoutRecordScope> layouts;
+    if (run_dir) layouts.emplace(run_dir->file("layouts.json"));
     const nlohmann::ordered_json results = body(options, resolved, run_dir.get());
     if (run_dir) run_dir->write_results(results);
   });

@@ -6,6 +6,8 @@
 #include <spdlog/version.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <thread>
 
 #include "core/runtime.h"
@@ -38,6 +40,30 @@ std::string cpu_simd() {
   return "baseline x86-64";
 }
 }  // namespace
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  const std::string key = "model name";
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(key, 0) != 0) continue;
+    const size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    const size_t begin = line.find_first_not_of(" \t", colon + 1);
+    if (begin != std::string::npos) return line.substr(begin);
+  }
+  return "unknown CPU";
+}
+
+std::filesystem::path user_cache_dir() {
+  const auto env = [](const char* name) -> std::string {
+    const char* value = std::getenv(name);
+    return value ? value : "";
+  };
+  if (const std::string dir = env("CGSR_CACHE_DIR"); !dir.empty()) return dir;
+  if (const std::string dir = env("XDG_CACHE_HOME"); !dir.empty()) return std::filesystem::path(dir) / "cgsr";
+  if (const std::string home = env("HOME"); !home.empty()) return std::filesystem::path(home) / ".cache" / "cgsr";
+  return {};
+}
 
 nlohmann::ordered_json system_info() {
   nlohmann::ordered_json j;

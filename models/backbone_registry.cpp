@@ -2,14 +2,14 @@
 
 #include <cctype>
 
-#include "models/backbones/edsr.h"
-#include "models/backbones/pan.h"
-#include "models/backbones/srcnn.h"
+// register_backbone_files(): declares and calls register_backbone_<name> of every
+// models/backbones/<name>.cpp; generated when configuring (models/CMakeLists.txt).
+#include "models/backbone_files.inc"
 
 namespace cgsr {
 
-const Registry<BackboneInfo>& backbone_registry() {
-  static const Registry<BackboneInfo> registry = [] {
+Registry<BackboneInfo>& backbone_registry() {
+  static Registry<BackboneInfo> registry = [] {
     Registry<BackboneInfo> r("backbone");
     register_builtin_backbones(r);
     return r;
@@ -17,11 +17,7 @@ const Registry<BackboneInfo>& backbone_registry() {
   return registry;
 }
 
-void register_builtin_backbones(Registry<BackboneInfo>& registry) {
-  registry.add("srcnn", srcnn_info(), srcnn_info().description);
-  registry.add("edsr", edsr_info(), edsr_info().description);
-  registry.add("pan", pan_info(), pan_info().description);
-}
+void register_builtin_backbones(Registry<BackboneInfo>& registry) { register_backbone_files(registry); }
 
 std::string block_group(int block, const std::string& suffix) {
   return "block" + std::to_string(block) + "_" + suffix;

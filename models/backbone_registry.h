@@ -1,6 +1,13 @@
 #pragma once
 // Backbones by name: what each one is (layer groups with their default widths, block range,
-// colour modes) and how to build it from a spec. Filled by register_builtin_backbones().
+// colour modes) and how to build it from a spec.
+//
+// Adding a backbone is adding one file, models/backbones/<name>.cpp, that defines
+//   void register_backbone_<name>(Registry<BackboneInfo>& registry);  // registry.add("<name>", ...)
+// Nothing else is edited: configuring globs models/backbones/*.cpp and generates the list that
+// register_builtin_backbones() calls, in file-name order (models/CMakeLists.txt). The registry
+// is filled explicitly on first use, never by static initializers. Worked example:
+// docs/extending.md.
 
 #include <functional>
 #include <memory>
@@ -35,7 +42,10 @@ struct BackboneInfo {
   std::function<std::shared_ptr<BackboneImpl>(const ArchSpec& spec)> build;
 };
 
-const Registry<BackboneInfo>& backbone_registry();
+// The process-wide table, the built-in backbones already in it. A program that embeds cgsr may
+// add its own with registry.add (before it builds networks; names are unique).
+Registry<BackboneInfo>& backbone_registry();
+// Calls register_backbone_<name> of every file in models/backbones/.
 void register_builtin_backbones(Registry<BackboneInfo>& registry);
 
 // "block3_a"

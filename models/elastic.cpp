@@ -147,8 +147,13 @@ SubnetConfig ElasticSpace::repair(SubnetConfig sub) const {
 }
 
 ElasticNetwork make_elastic(const SRNetworkImpl& net, const ElasticOptions& options) {
+  return make_elastic(net, options, channel_importance(net));
+}
+
+ElasticNetwork make_elastic(const SRNetworkImpl& net, const ElasticOptions& options,
+                            const std::map<std::string, torch::Tensor>& importance) {
   std::map<std::string, std::vector<int64_t>> order;
-  for (const auto& [group, scores] : channel_importance(net)) {
+  for (const auto& [group, scores] : importance) {
     const auto s = scores.detach().to(torch::kDouble).contiguous();
     const double* p = s.data_ptr<double>();
     std::vector<int64_t> idx(s.numel());

@@ -14,6 +14,7 @@
 //   SubnetConfig sub = space.sample(rng);                 // every gene drawn from its choices
 //   graph::Graph g = subnet_graph(*net, sub);
 
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -90,7 +91,12 @@ struct ElasticNetwork {
   SRNetwork network{nullptr};
   ElasticSpace space;
 };
+// Channels sorted by the magnitude criterion (importance/channel_importance.h).
 ElasticNetwork make_elastic(const SRNetworkImpl& net, const ElasticOptions& options);
+// Channels sorted by `importance`, any criterion's scores: layer group -> [width], higher first
+// (ties keep the channel order). Groups it leaves out keep their order.
+ElasticNetwork make_elastic(const SRNetworkImpl& net, const ElasticOptions& options,
+                            const std::map<std::string, torch::Tensor>& importance);
 
 // What a model file records of an elastic network (provenance.extra["elastic"]): the options
 // and the block order, so a later command rebuilds the same space.

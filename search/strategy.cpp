@@ -14,10 +14,8 @@ config::Schema<EvolutionOptions> evolution_schema() {
   return s;
 }
 
-namespace {
-// Draws subnets until `count` new ones are found or attempts run out (the space is exhausted).
-std::vector<SubnetConfig> collect(int count, const std::function<bool(const std::string&)>& seen,
-                                  const std::function<SubnetConfig()>& draw) {
+std::vector<SubnetConfig> collect_unseen(int count, const std::function<bool(const std::string&)>& seen,
+                                         const std::function<SubnetConfig()>& draw) {
   std::vector<SubnetConfig> out;
   std::set<std::string> taken;
   const int max_attempts = 50 * std::max(1, count);
@@ -30,18 +28,19 @@ std::vector<SubnetConfig> collect(int count, const std::function<bool(const std:
   return out;
 }
 
+namespace {
 class Evolution : public SearchStrategy {
  public:
   Evolution(const ElasticSpace& space, EvolutionOptions options) : space_(space), options_(options) {}
   std::vector<SubnetConfig> propose(const std::vector<Candidate>& population, int count,
                                     const std::function<bool(const std::string&)>& seen,
                                     std::mt19937_64& rng) override {
-    if (population.empty()) return collect(count, seen, [&] { return space_.sample(rng); });
+    if (population.empty()) return collect_unseen(count, seen, [&] { return space_.sample(rng); });
     std::uniform_real_distribution<double> u(0, 1);
     std::uniform_int_distribution<size_t> pick(0, population.size() - 1);
     // Binary tournament: the population is sorted best first, so the lower index wins.
     const auto parent = [&]() -> const SubnetConfig& { return population[std::min(pick(rng), pick(rng))].subnet; };
-    return collect(count, seen, [&] {
+    return collect_unseen(count, seen, [&] {
       if (population.size() >= 2 && u(rng) < options_.crossover_rate)
         return mutate(space_, crossover(space_, parent(), parent(), rng), options_.mutation_rate, rng);
       return mutate(space_, parent(), options_.mutation_rate, rng);
@@ -59,7 +58,7 @@ class RandomSearch : public SearchStrategy {
   std::vector<SubnetConfig> propose(const std::vector<Candidate>&, int count,
                                     const std::function<bool(const std::string&)>& seen,
                                     std::mt19937_64& rng) override {
-    return collect(count, seen, [&] { return space_.sample(rng); });
+    return collect_unseen(count, seen, [&] { return space_.sample(rng); });
   }
 
  private:
@@ -67,8 +66,14 @@ class RandomSearch : public SearchStrategy {
 };
 }  // namespace
 
-const Registry<StrategyType>& strategy_registry() {
-  static const Registry<StrategyType> registry = [] {
+void parse_no_strategy_options(const YAML::Node& block, StrategyOptions& options, const config::Cursor& at) {
+  for (const auto& kv : block)
+    if (!kv.first.IsScalar() || kv.first.Scalar() != "type")
+      at.fail(kv.first, "the " + options.type + " strategy has no options; only 'type' belongs here");
+}
+
+Registry<StrategyType>& strategy_registry() {
+  static Registry<StrategyType> registry = [] {
     Registry<StrategyType> r("search strategy");
     r.add("evolution",
           {[](const YAML::Node& block, StrategyOptions& o, const config::Cursor& at) {
@@ -82,12 +87,7 @@ const Registry<StrategyType>& strategy_registry() {
            }},
           "NSGA-II: tournament on Pareto rank and crowding, crossover and mutation (CGSR)");
     r.add("random",
-          {[](const YAML::Node& block, StrategyOptions&, const config::Cursor& at) {
-             for (const auto& kv : block)
-               if (!kv.first.IsScalar() || kv.first.Scalar() != "type")
-                 at.fail(kv.first, "the random strategy has no options; only 'type' belongs here");
-           },
-           [](const StrategyOptions&, YAML::Node&) {},
+          {parse_no_strategy_options, [](const StrategyOptions&, YAML::Node&) {},
            [](const ElasticSpace& space, const StrategyOptions&) { return std::make_unique<RandomSearch>(space); }},
           "uniform samples of the search space (baseline)");
     return r;

@@ -54,13 +54,23 @@ class SearchStrategy {
                                             std::mt19937_64& rng) = 0;
 };
 
+// What a propose() usually does: calls `draw` until it has `count` subnets neither `seen` nor
+// drawn twice, or until 50 x count attempts found no more (the space is exhausted).
+std::vector<SubnetConfig> collect_unseen(int count, const std::function<bool(const std::string&)>& seen,
+                                         const std::function<SubnetConfig()>& draw);
+
 // A strategy by name: how its options block is read and written, and the factory.
 struct StrategyType {
   std::function<void(const YAML::Node& block, StrategyOptions& options, const config::Cursor& at)> parse_options;
   std::function<void(const StrategyOptions& options, YAML::Node& block)> emit_options;
   std::function<std::unique_ptr<SearchStrategy>(const ElasticSpace& space, const StrategyOptions& options)> make;
 };
-const Registry<StrategyType>& strategy_registry();
+// The process-wide table, evolution and random already in it. A built-in strategy is added in
+// strategy.cpp; a program that embeds cgsr adds its own with strategy_registry().add(...) before
+// it parses search configs (docs/extending.md).
+Registry<StrategyType>& strategy_registry();
+// parse_options of a strategy without options: only `type` may stand in its block.
+void parse_no_strategy_options(const YAML::Node& block, StrategyOptions& options, const config::Cursor& at);
 
 }  // namespace cgsr
 

@@ -38,7 +38,8 @@ config::Schema<TrainSchedule> schedule_schema() {
           "consecutive steps with a non-finite loss or gradient before training stops")
       .at_least(1);
   s.field("layout", &TrainSchedule::layout,
-          "activation memory layout: auto measures both on the first batch and keeps the faster");
+          "activation memory layout: auto measures both on the first batch once per machine and keeps the "
+          "faster (models/memory_layout.h); nchw or nhwc pins it");
   s.field("prefetch", &TrainSchedule::prefetch,
           "batches built ahead on other threads; 0 builds each on the training thread between steps "
           "(no thread competes with the compute threads)")
@@ -196,8 +197,7 @@ MemoryLayout Trainer::choose_layout(const Batch& batch) {
   // Forward and backward without hooks or optimizer step: gradients are zeroed before every
   // real step, so the measurement leaves nothing behind.
   const auto shape = batch.lr_color.sizes();
-  const std::string key = "training of " + network_->spec().backbone + (network_->has_rit() ? " + RIT" : "") +
-                          " x" + std::to_string(network_->spec().scale) + " on " + std::to_string(shape[0]) + "x" +
+  const std::string key = "training of " + spec_summary(network_->spec()) + " on " + std::to_string(shape[0]) + "x" +
                           std::to_string(shape[3]) + "x" + std::to_string(shape[2]) + " patches";
   const MemoryLayout chosen = measured_layout(key, [&](MemoryLayout layout) {
     set_parameter_layout(*network_, layout);

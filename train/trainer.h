@@ -2,8 +2,9 @@
 // Training of a network on patches of a data set: Adam with cosine annealing, the CGSR loss,
 // gradient-norm clipping, a guard against non-finite steps, validation on full frames, best and
 // last weights, and checkpoints that resume the same schedule exactly (weights, optimizer state,
-// step, RNG state, memory layout). Steps run in the memory layout measured fastest (or the one
-// the schedule names); a run is bit-reproducible within one layout, and the network is handed
+// step, RNG state, memory layout). Steps run in the memory layout measured fastest once per
+// machine (or the one the schedule names; memory_layout.h measured_layout); a run is
+// bit-reproducible within one layout, and the network is handed
 // back in NCHW. Used by `cgsr train` and, through the search command, for search candidates.
 
 #include <torch/optim/adam.h>
@@ -48,7 +49,7 @@ struct TrainSchedule {
   int val_frames = 8;           // validation frames (spread over the split); 0 = all
   int checkpoint_every = 100;   // steps
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
-  MemoryLayout layout = MemoryLayout::Auto;  // activation memory layout: auto (measured), nchw or nhwc
+  MemoryLayout layout = MemoryLayout::Auto;  // activation memory layout: auto (measured once per machine), nchw or nhwc
   int prefetch = 2;             // batches built ahead on other threads (0: between steps)
 };
 config::Schema<TrainSchedule> schedule_schema();

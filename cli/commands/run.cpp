@@ -5,6 +5,7 @@
 
 #include "cli/command.h"
 #include "core/text.h"
+#include "models/memory_layout.h"
 #include "pipeline/pipeline.h"
 
 namespace fs = std::filesystem;
@@ -33,6 +34,8 @@ void setup_run(CLI::App& app) {
           own = std::make_unique<RunDir>(dir);
           own->write_config(resolved);
         }
+        // At the root, so that a stage that reruns (and starts from an empty directory) keeps them.
+        LayoutRecordScope layouts(dir / "layouts.json");
         return run_pipeline(options, resolved, dir);
       },
       /*always_run_dir=*/false, /*place_run_dir=*/{},

@@ -13,7 +13,8 @@ std::vector<GroupDefault> edsr_groups(int scale, int blocks) {
 }
 }  // namespace
 
-BackboneInfo edsr_info() {
+// Called by register_builtin_backbones (backbone_registry.h: one file per backbone).
+void register_backbone_edsr(Registry<BackboneInfo>& registry) {
   BackboneInfo info;
   info.description = "EDSR-baseline: 64 features, 16 residual blocks, pixel-shuffle upsampler";
   info.default_blocks = 16;
@@ -22,7 +23,7 @@ BackboneInfo edsr_info() {
   info.block_group_suffixes = {"mid"};
   info.groups = edsr_groups;
   info.build = [](const ArchSpec& spec) -> std::shared_ptr<BackboneImpl> { return std::make_shared<EdsrImpl>(spec); };
-  return info;
+  registry.add("edsr", info, info.description);
 }
 
 EdsrBlockImpl::EdsrBlockImpl(int index, int64_t features, int64_t mid) : index_(index) {

@@ -21,8 +21,6 @@
 
 namespace cgsr {
 
-BackboneInfo edsr_info();
-
 class EdsrBlockImpl : public torch::nn::Module {
  public:
   EdsrBlockImpl(int index, int64_t features, int64_t mid);

@@ -29,7 +29,8 @@ std::vector<GroupDefault> pan_groups(int scale, int blocks) {
 }
 }  // namespace
 
-BackboneInfo pan_info() {
+// Called by register_builtin_backbones (backbone_registry.h: one file per backbone).
+void register_backbone_pan(Registry<BackboneInfo>& registry) {
   BackboneInfo info;
   info.description = "PAN: pixel attention network (nf 40, unf 24, 16 SC-PA blocks)";
   info.default_blocks = 16;
@@ -39,7 +40,7 @@ BackboneInfo pan_info() {
   info.block_group_suffixes = block_suffixes();
   info.groups = pan_groups;
   info.build = [](const ArchSpec& spec) -> std::shared_ptr<BackboneImpl> { return std::make_shared<PanImpl>(spec); };
-  return info;
+  registry.add("pan", info, info.description);
 }
 
 // ---- pixel attention ---------------------------------------------------------------------------

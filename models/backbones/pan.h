@@ -24,8 +24,6 @@
 
 namespace cgsr {
 
-BackboneInfo pan_info();
-
 // x * sigmoid(conv1x1(x)): PAN's pixel attention in the upsampler.
 class PixelAttentionImpl : public torch::nn::Module {
  public:

@@ -6,7 +6,8 @@
 
 namespace cgsr {
 
-BackboneInfo srcnn_info() {
+// Called by register_builtin_backbones (backbone_registry.h: one file per backbone).
+void register_backbone_srcnn(Registry<BackboneInfo>& registry) {
   BackboneInfo info;
   info.description = "SRCNN 9-5-5 (64/32 filters) on the bicubic-upsampled input, RGB or Y";
   info.default_blocks = 0;
@@ -15,7 +16,7 @@ BackboneInfo srcnn_info() {
   info.supports_y = true;
   info.groups = [](int, int) { return std::vector<GroupDefault>{{"conv1", 64}, {"conv2", 32}}; };
   info.build = [](const ArchSpec& spec) -> std::shared_ptr<BackboneImpl> { return std::make_shared<SrcnnImpl>(spec); };
-  return info;
+  registry.add("srcnn", info, info.description);
 }
 
 SrcnnImpl::SrcnnImpl(const ArchSpec& spec) : scale_(spec.scale), luma_(spec.colors == Colors::Y) {

@@ -16,8 +16,6 @@
 
 namespace cgsr {
 
-BackboneInfo srcnn_info();
-
 class SrcnnImpl : public BackboneImpl {
  public:
   explicit SrcnnImpl(const ArchSpec& spec);

@@ -1,12 +1,14 @@
 #pragma once
 // Shared fixtures of the models tests: every backbone at every scale, and small inputs.
 
+#include <gtest/gtest.h>
 #include <torch/torch.h>
 
 #include <string>
 #include <vector>
 
 #include "models/arch_spec.h"
+#include "models/backbone_registry.h"
 #include "models/sr_network.h"
 
 namespace cgsr::test {
@@ -17,11 +19,16 @@ struct BackboneCase {
   std::string colors;
 };
 
+// Every registered backbone at every scale, and in Y where it supports luma: a backbone added to
+// models/backbones/ is checked by every test that loops over these as soon as its file exists.
 inline std::vector<BackboneCase> all_backbone_cases() {
   std::vector<BackboneCase> cases;
-  for (const char* b : {"srcnn", "edsr", "pan"})
+  const auto& registry = backbone_registry();
+  for (const auto& b : registry.names())
     for (int s : {2, 3, 4}) cases.push_back({b, s, "rgb"});
-  for (int s : {2, 3, 4}) cases.push_back({"srcnn", s, "y"});
+  for (const auto& b : registry.names())
+    if (registry.get(b).supports_y)
+      for (int s : {2, 3, 4}) cases.push_back({b, s, "y"});
   return cases;
 }
 
@@ -78,6 +85,25 @@ inline SRNetwork build_network(const ArchSpec& spec, uint64_t seed) {
   }
   net->eval();
   return net;
+}
+
+// The graph contract (models/graph.h): interpreting the network's training graph reproduces
+// forward_train() bit for bit, the geometry head's output too.
+inline void expect_graph_matches_forward(const ArchSpec& spec) {
+  SRNetwork net(spec);
+  if (net->has_rit()) randomize_fusion(*net, 0.1);  // so the RIT path is exercised
+  const auto [color, info] = random_inputs(spec, 7, 5);
+  torch::NoGradGuard no_grad;
+  const auto expected = net->forward_train(color, info);
+  const auto g = net->describe(/*training=*/true);
+  const auto outputs = graph::run(g, network_inputs(g, color, info));
+  ASSERT_GE(outputs.size(), 1u);
+  EXPECT_EQ(outputs[0].first, "image");
+  EXPECT_TRUE(torch::equal(outputs[0].second, expected.image));
+  if (spec.geometry.enabled) {
+    ASSERT_EQ(outputs.size(), 2u);
+    EXPECT_TRUE(torch::equal(outputs[1].second, expected.geometry));
+  }
 }
 
 }  // namespace cgsr::test

@@ -10,25 +10,6 @@
 using namespace cgsr;
 using namespace cgsr::test;
 
-namespace {
-void expect_graph_matches_forward(const ArchSpec& spec) {
-  SRNetwork net(spec);
-  if (net->has_rit()) randomize_fusion(*net, 0.1);  // so the RIT path is exercised
-  const auto [color, info] = random_inputs(spec, 7, 5);
-  torch::NoGradGuard no_grad;
-  const auto expected = net->forward_train(color, info);
-  const auto g = net->describe(/*training=*/true);
-  const auto outputs = graph::run(g, network_inputs(g, color, info));
-  ASSERT_GE(outputs.size(), 1u);
-  EXPECT_EQ(outputs[0].first, "image");
-  EXPECT_TRUE(torch::equal(outputs[0].second, expected.image));
-  if (spec.geometry.enabled) {
-    ASSERT_EQ(outputs.size(), 2u);
-    EXPECT_TRUE(torch::equal(outputs[1].second, expected.geometry));
-  }
-}
-}  // namespace
-
 TEST(Graph, InterpreterReproducesEveryBackbone) {
   torch::manual_seed(1);
   for (const auto& c : all_backbone_cases()) {

@@ -1,12 +1,20 @@
-// The inference helper: eval mode, no autograd, identical results in both memory layouts.
+// The inference helper: eval mode, no autograd, identical results in both memory layouts; the
+// choice of a layout, made once per machine and recorded in the run directory.
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
 #include <thread>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/runtime.h"
+#include "core/system_info.h"
 #include "models/inference.h"
 #include "tests/models/model_cases.h"
+#include "tests/support/cli_runner.h"
 
 using namespace cgsr;
 using namespace cgsr::test;
@@ -58,17 +66,80 @@ TEST(MemoryLayout, ParametersChangeLayoutInPlaceAndKeepValues) {
   for (const auto& p : net->parameters()) EXPECT_TRUE(p.is_contiguous());
 }
 
-TEST(MemoryLayout, MeasuredChoiceIsRememberedPerKey) {
-  int calls = 0;
-  const auto run = [&](MemoryLayout layout) {
+namespace {
+// An empty machine cache of its own (CGSR_CACHE_DIR) and a process that remembers nothing yet.
+std::filesystem::path fresh_layout_cache(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cgsr-layouts-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  ::setenv("CGSR_CACHE_DIR", dir.c_str(), 1);
+  forget_measured_layouts();
+  return dir;
+}
+
+// A timing that makes `slow` slow on purpose, counting its calls.
+std::function<void(MemoryLayout)> timing_where_slow(MemoryLayout slow, int& calls) {
+  return [slow, &calls](MemoryLayout layout) {
     ++calls;
-    // NCHW made slow on purpose: the measurement must pick NHWC.
-    if (layout == MemoryLayout::Nchw) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (layout == slow) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   };
+}
+}  // namespace
+
+TEST(MemoryLayout, MeasuredChoiceIsRememberedPerKey) {
+  fresh_layout_cache("remembered");
+  int calls = 0;
+  const auto run = timing_where_slow(MemoryLayout::Nchw, calls);
   EXPECT_EQ(measured_layout("test key", run, 3), MemoryLayout::Nhwc);
   EXPECT_EQ(calls, 8);  // one warm-up and three rounds of each
   EXPECT_EQ(measured_layout("test key", run, 3), MemoryLayout::Nhwc);
   EXPECT_EQ(calls, 8);
+}
+
+// What a busy machine does to a timing: it may now prefer the other layout. The cached decision
+// holds, so every run of a config on this machine trains in one layout.
+TEST(MemoryLayout, ACachedChoiceIsReusedWhenATimingWouldNowPreferTheOtherLayout) {
+  const auto dir = fresh_layout_cache("cached");
+  int calls = 0;
+  EXPECT_EQ(measured_layout("cached key", timing_where_slow(MemoryLayout::Nchw, calls)), MemoryLayout::Nhwc);
+  EXPECT_EQ(calls, 8);
+  // Keyed by the key, the thread count and the CPU model.
+  const auto cache = read_json(dir / "layouts.json");
+  EXPECT_EQ(layout_cache_file(), dir / "layouts.json");
+  EXPECT_EQ(cache.at(machine_layout_key("cached key")), "nhwc") << cache.dump();
+  EXPECT_NE(machine_layout_key("cached key").find(std::to_string(thread_count()) + " threads"), std::string::npos);
+  EXPECT_NE(machine_layout_key("cached key").find(cpu_model()), std::string::npos);
+
+  forget_measured_layouts();  // a new process
+  EXPECT_EQ(measured_layout("cached key", timing_where_slow(MemoryLayout::Nhwc, calls)), MemoryLayout::Nhwc);
+  EXPECT_EQ(calls, 8);  // not measured again
+  // Another network or input shape is decided on its own.
+  EXPECT_EQ(measured_layout("other key", timing_where_slow(MemoryLayout::Nhwc, calls)), MemoryLayout::Nchw);
+  EXPECT_EQ(calls, 16);
+  std::filesystem::remove_all(dir);
+}
+
+// A run directory's record comes before the machine's cache (a rerun on another machine, or after
+// the cache was cleared, runs as the run did), and takes what the cache or a timing decided.
+TEST(MemoryLayout, TheRunDirectorysRecordComesFirstAndRecordsEveryChoice) {
+  const auto dir = fresh_layout_cache("record");
+  const auto record = dir / "run" / "layouts.json";
+  write_file_atomic(record, R"({"recorded key": "nchw"})");
+  int calls = 0;
+  {
+    LayoutRecordScope scope(record);
+    EXPECT_EQ(measured_layout("recorded key", timing_where_slow(MemoryLayout::Nchw, calls)), MemoryLayout::Nchw);
+    EXPECT_EQ(calls, 0);
+    EXPECT_EQ(measured_layout("new key", timing_where_slow(MemoryLayout::Nchw, calls)), MemoryLayout::Nhwc);
+    EXPECT_EQ(calls, 8);
+  }
+  const auto recorded = read_json(record);
+  EXPECT_EQ(recorded, (nlohmann::json{{"new key", "nhwc"}, {"recorded key", "nchw"}}));
+
+  write_file_atomic(record, R"({"recorded key": "auto"})");
+  forget_measured_layouts();
+  LayoutRecordScope scope(record);
+  EXPECT_THROW(measured_layout("recorded key", timing_where_slow(MemoryLayout::Nchw, calls)), Error);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Inference, AutoLayoutGivesTheReferenceOutput) {

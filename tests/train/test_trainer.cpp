@@ -1,9 +1,14 @@
 // The trainer on a tiny rendered scene: the memory layout of its steps changes results only
-// within float tolerance, the network comes back in NCHW, and the choice is recorded; steps with
+// within float tolerance, the network comes back in NCHW, and the choice is made once per
+// machine, recorded and kept by a resumed run or a rerun of the run directory; steps with
 // a non-finite loss or gradient are skipped and counted, and a run that blows up stops with an error.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
@@ -72,6 +77,94 @@ TEST(Trainer, AutoLayoutRecordsItsChoice) {
   const auto [net, outcome] = train(MemoryLayout::Auto);
   EXPECT_TRUE(outcome.layout == MemoryLayout::Nchw || outcome.layout == MemoryLayout::Nhwc) << enum_name(outcome.layout);
   for (const auto& p : net->parameters()) EXPECT_TRUE(p.is_contiguous());
+}
+
+namespace {
+MemoryLayout other(MemoryLayout layout) { return layout == MemoryLayout::Nhwc ? MemoryLayout::Nchw : MemoryLayout::Nhwc; }
+
+// An empty machine cache of layouts of its own (CGSR_CACHE_DIR), which every cgsr process the
+// test starts uses too.
+std::filesystem::path fresh_layout_cache(const std::string& name) {
+  const auto dir = scratch_dir("layouts-" + name);
+  ::setenv("CGSR_CACHE_DIR", dir.c_str(), 1);
+  forget_measured_layouts();
+  return dir;
+}
+
+// Rewrites every decision of a layouts.json to the other layout: what a timing on a busy machine
+// might have decided instead.
+void flip_layouts(const std::filesystem::path& file) {
+  nlohmann::json j = read_json(file);
+  ASSERT_FALSE(j.empty());
+  for (auto& [key, value] : j.items())
+    value = enum_name(other(enum_from_name<MemoryLayout>(value.get<std::string>())));
+  write_file_atomic(file, j.dump());
+}
+}  // namespace
+
+// `auto` trains in the layout this machine decided once, whatever a timing would say now, so two
+// runs of one config agree bit for bit.
+TEST(Trainer, AutoLayoutIsTheMachinesCachedDecisionSoRunsAgreeBitForBit) {
+  set_threads(1);
+  const auto cache = fresh_layout_cache("trainer");
+  const auto [measured, measured_outcome] = train(MemoryLayout::Auto);
+  flip_layouts(cache / "layouts.json");
+  forget_measured_layouts();  // as a new process
+  const auto [first, first_outcome] = train(MemoryLayout::Auto);
+  EXPECT_EQ(first_outcome.layout, other(measured_outcome.layout));
+  forget_measured_layouts();
+  const auto [second, second_outcome] = train(MemoryLayout::Auto);
+  EXPECT_EQ(second_outcome.layout, first_outcome.layout);
+  const auto a = first->parameters(), b = second->parameters();
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << i;
+  std::filesystem::remove_all(cache);
+}
+
+// A resumed run goes on in the layout its checkpoint was written in, whatever the machine's
+// cache says by then.
+TEST(Trainer, AResumedRunKeepsItsLayout) {
+  set_threads(1);
+  const auto cache = fresh_layout_cache("resume");
+  const auto checkpoint = cache / "checkpoint.pt";
+  const Dataset data = Dataset::open(tiny_data());
+  TrainSchedule schedule = short_schedule(MemoryLayout::Auto);
+  schedule.checkpoint_every = 1;
+  seed_everything(3);
+  schedule.steps = 3;
+  const TrainOutcome begun = Trainer(SRNetwork(small_pan()), data, schedule, LossOptions{}).run(checkpoint);
+  flip_layouts(cache / "layouts.json");
+  forget_measured_layouts();
+  seed_everything(3);
+  schedule.steps = 6;
+  const TrainOutcome resumed = Trainer(SRNetwork(small_pan()), data, schedule, LossOptions{}).run(checkpoint, true);
+  EXPECT_TRUE(resumed.resumed);
+  EXPECT_EQ(resumed.layout, begun.layout);
+  std::filesystem::remove_all(cache);
+}
+
+// `cgsr train` records the layouts it chose in its run directory (layouts.json); a rerun of the
+// directory uses them before the machine's cache (which another machine, or a cleared cache,
+// would decide anew).
+TEST(TrainCommand, ARerunOfItsRunDirectoryTrainsInTheLayoutItRecorded) {
+  const auto cache = fresh_layout_cache("command");
+  const auto out = cache / "run";
+  const std::string train = "train --data " + tiny_data().string() +
+                            " --model pan --steps 2 --threads 1 --set schedule.batch_size=2"
+                            " --set schedule.patch_size=16 --set schedule.val_frames=1 --out " + out.string();
+  auto r = run_cgsr(train);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string used = read_json(out / "results.json")["training"]["layout"];
+  const auto recorded = read_json(out / "layouts.json");
+  ASSERT_EQ(recorded.size(), 1u) << recorded.dump();
+  EXPECT_EQ(recorded.begin().value(), used);
+  EXPECT_EQ(recorded.begin().key().rfind("training of pan x2 on 2x16x16 patches", 0), 0u) << recorded.dump();
+
+  flip_layouts(cache / "layouts.json");
+  r = run_cgsr(train);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_json(out / "results.json")["training"]["layout"], used);
+  EXPECT_NE(r.err.find("as recorded in " + (out / "layouts.json").string()), std::string::npos) << r.err;
+  std::filesystem::remove_all(cache);
 }
 
 // Adam's first step moves every weight with a gradient by the learning rate, so after one step
