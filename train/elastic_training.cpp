@@ -89,7 +89,7 @@ TrainHooks subnet_training_hooks(SRNetwork network, std::function<std::vector<Su
       if (distill > 0) total = total + distill * reconstruction_error(out, target, loss.image_norm);
       if (distill < 1) total = total + (1 - distill) * reconstruction_error(out, batch.hr_color, loss.image_norm);
     }
-    return total;
+    return total / static_cast<double>(chosen.size());
   };
   return hooks;
 }
