@@ -63,7 +63,16 @@ void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& pl
   if (ys.empty()) throw Error(path.string(), "nothing to plot");
   if (xs.empty()) xs = {0.0, 1.0};
 
-  const int width = 960, height = 600, left = 80, right = 300, top = 50, bottom = 70;
+  // The legend column grows with its longest entry, so no entry is cut off at the image's edge.
+  int longest = 0;
+  auto measure = [&](const std::string& text) {
+    longest = std::max(longest, cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, nullptr).width);
+  };
+  for (const auto& [y, text] : plot.horizontal_lines) measure("--- " + text);
+  for (const auto& s : plot.series) measure(s.name);
+  for (const auto& note : plot.notes) measure(note);
+  const int left = 80, right = std::max(300, longest + 24), top = 50, bottom = 70;
+  const int width = 660 + right, height = 600;
   auto pad = [](double lo, double hi) {
     const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5;
     return std::make_pair(lo - margin, hi + margin);

@@ -28,16 +28,6 @@ config::Schema<ElasticOptions> elastic_options_schema() {
 }
 
 namespace {
-// Full widths of the spec's elastic groups, in order: the backbone's, then the RIT's.
-std::vector<std::pair<std::string, int64_t>> group_list(const ArchSpec& spec) {
-  std::vector<std::pair<std::string, int64_t>> out;
-  for (const auto& [group, width] : spec.widths.entries()) out.emplace_back(group, width);
-  if (spec.rit.enabled) {
-    if (spec.rit.feature_branch()) out.emplace_back("rit", spec.rit.width);
-    if (spec.rit.hr_branch()) out.emplace_back("rit_hr", spec.rit.hr_width);
-  }
-  return out;
-}
 
 // Index of the allowed width a fraction `f` of the way from the full width (0) to the smallest (1).
 size_t limit_index(size_t choices, double f) {
@@ -59,7 +49,7 @@ ElasticSpace::ElasticSpace(const ArchSpec& spec, ElasticOptions options, std::ve
   if (sorted != expected)
     throw Error("elastic space", "the block order must list each of the network's " + std::to_string(spec_.blocks) +
                                      " blocks once");
-  const auto groups = group_list(spec_);
+  const auto groups = layer_groups(spec_);
   for (const auto& g : options_.fixed_groups)
     if (std::none_of(groups.begin(), groups.end(), [&](const auto& x) { return x.first == g; }))
       throw Error("elastic space: fixed_groups", "no layer group '" + g + "' in " + spec_summary(spec_));

@@ -13,10 +13,7 @@
 
 namespace cgsr {
 
-namespace {
-
-// Every layer group of a spec with its full width: the backbone's, then the RIT's.
-std::vector<std::pair<std::string, int64_t>> spec_groups(const ArchSpec& spec) {
+std::vector<std::pair<std::string, int64_t>> layer_groups(const ArchSpec& spec) {
   std::vector<std::pair<std::string, int64_t>> out;
   for (const auto& [group, width] : spec.widths.entries()) out.emplace_back(group, width);
   if (spec.rit.enabled) {
@@ -25,6 +22,8 @@ std::vector<std::pair<std::string, int64_t>> spec_groups(const ArchSpec& spec) {
   }
   return out;
 }
+
+namespace {
 
 bool kept_block(const SubnetConfig& sub, int block) {
   return std::binary_search(sub.blocks.begin(), sub.blocks.end(), block);
@@ -50,7 +49,7 @@ SubnetConfig full_subnet(const ArchSpec& spec) {
   SubnetConfig sub;
   sub.blocks.resize(std::max(spec.blocks, 0));
   std::iota(sub.blocks.begin(), sub.blocks.end(), 0);
-  for (const auto& [group, width] : spec_groups(spec)) sub.widths[group] = width;
+  for (const auto& [group, width] : layer_groups(spec)) sub.widths[group] = width;
   return sub;
 }
 
@@ -98,7 +97,7 @@ std::vector<std::string> subnet_problems(const ArchSpec& spec, const SubnetConfi
     else if (i > 0 && b <= sub.blocks[i - 1]) p.push_back("blocks must be ascending and distinct");
   }
   if (spec.blocks > 0 && sub.blocks.empty()) p.push_back("keeps no block");
-  const auto groups = spec_groups(spec);
+  const auto groups = layer_groups(spec);
   for (const auto& [group, width] : sub.widths) {
     const auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == group; });
     if (it == groups.end()) {
@@ -223,7 +222,7 @@ SRNetwork materialize_subnet(const SRNetworkImpl& net, const SubnetConfig& sub, 
   ArchSpec spec = subnet_spec(net.spec(), sub);
   if (!geometry_head) spec.geometry.enabled = false;
   std::map<std::string, std::vector<int64_t>> kept;
-  for (const auto& [group, width] : spec_groups(net.spec())) {
+  for (const auto& [group, width] : layer_groups(net.spec())) {
     const auto block = parse_block_group(group);
     if (block && !kept_block(sub, block->first)) continue;
     std::vector<int64_t> prefix(subnet_width(sub, group, width));

@@ -23,6 +23,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "models/arch_spec.h"
@@ -39,6 +40,9 @@ struct SubnetConfig {
   bool operator==(const SubnetConfig& o) const { return blocks == o.blocks && widths == o.widths; }
   bool operator!=(const SubnetConfig& o) const { return !(*this == o); }
 };
+
+// Every layer group of a (resolved) spec with its full width, in order: the backbone's, then the RIT's.
+std::vector<std::pair<std::string, int64_t>> layer_groups(const ArchSpec& spec);
 
 // Every block and every channel of a (resolved) spec: the full network as a subnet.
 SubnetConfig full_subnet(const ArchSpec& spec);
