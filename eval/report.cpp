@@ -15,6 +15,14 @@
 
 namespace cgsr {
 namespace {
+// A CSV field as RFC 4180 writes it: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
 struct Cells {
   std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
 };
@@ -115,8 +123,9 @@ std::string report_csv(const std::vector<ReportTable>& tables) {
          "onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n";
   for (const auto& t : tables)
     for (const auto& r : t.rows) {
-      csv << t.dataset << "," << t.scale << "," << r.name << "," << (r.cost ? std::to_string(r.cost->params) : "")
-          << "," << (r.cost ? std::to_string(r.cost->macs) : "") << ","
+      csv << csv_field(t.dataset) << "," << t.scale << "," << csv_field(r.name) << ","
+          << (r.cost ? std::to_string(r.cost->params) : "") << ","
+          << (r.cost ? std::to_string(r.cost->macs) : "") << ","
           << (r.latency ? fixed(r.latency->median_ms, 4) : "") << "," << fixed(r.psnr, 4) << "," << fixed(r.ssim, 6)
           << "," << (r.temporal_error ? fixed(*r.temporal_error, 6) : "") << ","
           << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size() << ","

@@ -57,6 +57,13 @@ TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
   EXPECT_NE(csv.find("hall,2,pan,261403,261403000,12.0000,33.4560"), std::string::npos) << csv;
 }
 
+TEST(Report, CsvQuotesNamesWithCommasAndQuotes) {
+  ReportTable t{"hall, east", 2, {row("PAN x2 (keep 0.5, \"wide\")", 33.456, 12.0)}};
+  const auto csv = report_csv({t});
+  EXPECT_NE(csv.find("\n\"hall, east\",2,\"PAN x2 (keep 0.5, \"\"wide\"\")\",,,12.0000,33.4560"), std::string::npos)
+      << csv;
+}
+
 TEST(Report, ALatencyColumnOnlyWhenSomeRowWasTimed) {
   // A held-out scene is evaluated for quality only: no latency column, no Pareto front.
   ReportTable t{"hall", 2, {row("bicubic", 30.123, std::nullopt), row("pan", 33.456, std::nullopt, 261403)}};
