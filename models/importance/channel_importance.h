@@ -5,7 +5,7 @@
 // sum their r*r sub-channels.
 //
 // Users: inheritance keeps a narrower child's most important channels (models/inherit.h), the
-// CGSR loss fades the channels a search candidate will drop (train/losses.h: sum ||S_k||), and
+// CGSR loss can fade channels before they are cut (train/losses.h: sum ||S_k||), and
 // an elastic network sorts its channels by it (models/elastic.h make_elastic, which takes any
 // criterion's scores; docs/extending.md adds one), so the magnitude-pruning control
 // (pruning/equal_latency_controls.h) keeps the channels it ranks first.
