@@ -2,16 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 
 namespace cgsr {
 namespace {
-cv::Scalar bgr(const Rgb& c) { return cv::Scalar(c[2], c[1], c[0]); }
+const TextStyle kTitle{16, true}, kAxis{13}, kTick{11, false, {70, 70, 70}}, kLabel{11}, kLegend{12};
+const Rgb kBlack{0, 0, 0}, kGrid{225, 225, 225}, kFrame{60, 60, 60}, kLeader{150, 150, 150};
 
 std::string tick_text(double v) {
   std::ostringstream s;
@@ -20,13 +18,7 @@ std::string tick_text(double v) {
   return s.str();
 }
 
-void write_png(const std::filesystem::path& path, const cv::Mat& img) {
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", img, png)) throw Error(path.string(), "cannot encode the plot");
-  write_file_atomic(path, std::string(png.begin(), png.end()));
-}
-
-// "Nice" tick values covering [lo, hi].
+// "Nice" tick values covering [lo, hi] (for a log axis, lo and hi are log10 values).
 std::vector<double> ticks(double lo, double hi, bool log_scale) {
   std::vector<double> out;
   if (log_scale) {
@@ -49,9 +41,56 @@ std::vector<double> ticks(double lo, double hi, bool log_scale) {
   for (double k = std::ceil(lo / step); k * step <= hi + 1e-12; k += 1) out.push_back(k * step);
   return out;
 }
+
+std::pair<double, double> padded(double lo, double hi) {
+  const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5;
+  return {lo - margin, hi + margin};
+}
+
+bool collides(const Box& box, const std::vector<Box>& taken) {
+  return std::any_of(taken.begin(), taken.end(), [&](const Box& t) { return box.overlaps(t); });
+}
+
+// Draws a tick label unless it would overlap one already drawn (dense ticks thin out).
+void tick_label(Canvas& canvas, Point2 at, const std::string& text, Anchor anchor) {
+  const Box box = canvas.measure(text, kTick, at, anchor).grown(2);
+  if (box.inside(canvas.bounds()) && !collides(box, canvas.text_boxes())) canvas.text(at, text, kTick, anchor);
+}
+
+// Where a label of `size` may go around a marker of radius `r` at `p`: first right next to it
+// (east, west, the diagonals, north, south), then on rings further out, joined by a leader line.
+std::vector<Box> label_candidates(Point2 p, double r, const Box& size) {
+  const double w = size.width(), h = size.height(), d = r * 1.3 + 4;  // clear of the marker's box
+  std::vector<Box> out = {
+      {p.x + d, p.y - h / 2, p.x + d + w, p.y + h / 2},          {p.x - d - w, p.y - h / 2, p.x - d, p.y + h / 2},
+      {p.x + d * 0.7, p.y - d * 0.7 - h, p.x + d * 0.7 + w, p.y - d * 0.7},
+      {p.x - d * 0.7 - w, p.y - d * 0.7 - h, p.x - d * 0.7, p.y - d * 0.7},
+      {p.x + d * 0.7, p.y + d * 0.7, p.x + d * 0.7 + w, p.y + d * 0.7 + h},
+      {p.x - d * 0.7 - w, p.y + d * 0.7, p.x - d * 0.7, p.y + d * 0.7 + h},
+      {p.x - w / 2, p.y - d - h, p.x + w / 2, p.y - d},          {p.x - w / 2, p.y + d, p.x + w / 2, p.y + d + h}};
+  for (int ring = 1; ring <= 10; ++ring)
+    for (int k = 0; k < 16; ++k) {
+      const double a = k * M_PI / 8, dist = d + 14.0 * ring;
+      const double cx = p.x + std::cos(a) * (dist + w / 2), cy = p.y - std::sin(a) * (dist + h / 2);
+      out.push_back({cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2});
+    }
+  return out;
+}
+
+// The point of `box` nearest to `p` (where a leader line ends).
+Point2 nearest_on(const Box& box, Point2 p) {
+  return {std::clamp(p.x, box.x0, box.x1), std::clamp(p.y, box.y0, box.y1)};
+}
+
+struct PlacedLabel {
+  std::string text;
+  Point2 at;    // the marker
+  Box box;      // where the text goes
+  bool leader;  // away from the marker: a line joins them
+};
 }  // namespace
 
-void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot) {
+std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
   std::vector<double> xs, ys;
   for (const auto& s : plot.series)
     for (const auto& p : s.points) {
@@ -60,147 +99,208 @@ void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& pl
       ys.push_back(p.y);
     }
   for (const auto& [y, text] : plot.horizontal_lines) ys.push_back(y);
-  if (ys.empty()) throw Error(path.string(), "nothing to plot");
+  if (ys.empty()) throw Error("plot '" + plot.title + "'", "nothing to plot");
   if (xs.empty()) xs = {0.0, 1.0};
+  const auto [x_lo, x_hi] = padded(*std::min_element(xs.begin(), xs.end()), *std::max_element(xs.begin(), xs.end()));
+  const auto [y_lo, y_hi] = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
+  const auto x_ticks = ticks(x_lo, x_hi, plot.log_x), y_ticks = ticks(y_lo, y_hi, false);
 
-  // The legend column grows with its longest entry, so no entry is cut off at the image's edge.
-  int longest = 0;
-  auto measure = [&](const std::string& text) {
-    longest = std::max(longest, cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, nullptr).width);
-  };
-  for (const auto& [y, text] : plot.horizontal_lines) measure("--- " + text);
-  for (const auto& s : plot.series) measure(s.name);
-  for (const auto& note : plot.notes) measure(note);
-  const int left = 80, right = std::max(300, longest + 24), top = 50, bottom = 70;
-  const int width = 660 + right, height = 600;
-  auto pad = [](double lo, double hi) {
-    const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5;
-    return std::make_pair(lo - margin, hi + margin);
-  };
-  const auto [x_lo, x_hi] = pad(*std::min_element(xs.begin(), xs.end()), *std::max_element(xs.begin(), xs.end()));
-  const auto [y_lo, y_hi] = pad(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
+  // Margins from the text they hold; the legend column from its longest entry.
+  Canvas probe(1, 1);
+  double y_tick_width = 0;
+  for (double v : y_ticks) y_tick_width = std::max(y_tick_width, probe.measure(tick_text(v), kTick).width());
+  const double line_height = probe.measure("Ag", kLegend).height() + 5;
+  std::vector<std::string> legend_texts;
+  for (const auto& [y, text] : plot.horizontal_lines) legend_texts.push_back(text);
+  for (const auto& s : plot.series)
+    if (!s.name.empty()) legend_texts.push_back(s.name);
+  if (!plot.links.empty() && !plot.links_name.empty()) legend_texts.push_back(plot.links_name);
+  double legend_width = 0;
+  for (const auto& t : legend_texts) legend_width = std::max(legend_width, probe.measure(t, kLegend).width());
+  for (const auto& t : plot.notes) legend_width = std::max(legend_width, probe.measure(t, kLegend).width());
+
+  const double plot_w = 640, plot_h = 460;
+  const double left = 14 + probe.measure("Ag", kAxis).height() + 10 + y_tick_width + 8;
+  const double top = 16 + probe.measure("Ag", kTitle).height() + 14;
+  const double bottom = 8 + probe.measure("Ag", kTick).height() + 10 + probe.measure("Ag", kAxis).height() + 14;
+  const Box area{left, top, left + plot_w, top + plot_h};
   auto px = [&, x_lo = x_lo, x_hi = x_hi](double x) {
     const double v = plot.log_x ? std::log10(std::max(x, 1e-12)) : x;
-    return static_cast<int>(left + (v - x_lo) / (x_hi - x_lo) * (width - left - right));
+    return area.x0 + (v - x_lo) / (x_hi - x_lo) * plot_w;
   };
-  auto py = [&, y_lo = y_lo, y_hi = y_hi](double y) {
-    return static_cast<int>(height - bottom - (y - y_lo) / (y_hi - y_lo) * (height - top - bottom));
+  auto py = [&, y_lo = y_lo, y_hi = y_hi](double y) { return area.y1 - (y - y_lo) / (y_hi - y_lo) * plot_h; };
+
+  // Every point label, placed before anything is drawn: the ones with no free place become
+  // numbers, spelled out in the legend, which may then need more height.
+  std::vector<Box> taken;  // markers, then labels as they are placed
+  for (const auto& s : plot.series)
+    for (const auto& p : s.points)
+      if (!(plot.log_x && p.x <= 0))
+        taken.push_back(Box{px(p.x), py(p.y), px(p.x), py(p.y)}.grown(s.radius * 1.3 + 1));
+  const Box inner = area.grown(-3);
+  std::vector<PlacedLabel> placed;
+  std::vector<std::string> numbered;
+  auto place = [&](const std::string& text, Point2 at, double radius) {
+    const Box size = probe.measure(text, kLabel);
+    const auto candidates = label_candidates(at, radius, size);
+    for (size_t c = 0; c < candidates.size(); ++c)
+      if (candidates[c].inside(inner) && !collides(candidates[c].grown(1.5), taken)) {
+        taken.push_back(candidates[c]);
+        placed.push_back({text, at, candidates[c], c >= 8});
+        return true;
+      }
+    return false;
   };
+  for (const auto& s : plot.series)
+    for (const auto& p : s.points) {
+      if (p.label.empty() || (plot.log_x && p.x <= 0)) continue;
+      const Point2 at{px(p.x), py(p.y)};
+      if (place(p.label, at, s.radius)) continue;
+      const std::string number = std::to_string(numbered.size() + 1);
+      numbered.push_back(number + ": " + p.label);
+      if (!place(number, at, s.radius)) numbered.back() += " (not marked: no room)";
+    }
+  for (const auto& n : numbered) legend_width = std::max(legend_width, probe.measure(n, kLegend).width());
 
-  cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const cv::Scalar black(0, 0, 0), grey(215, 215, 215);
-  for (double v : ticks(x_lo, x_hi, plot.log_x)) {
-    const int x = px(v);
-    cv::line(img, {x, top}, {x, height - bottom}, grey, 1);
-    cv::putText(img, tick_text(v), {x - 14, height - bottom + 20}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
-  }
-  for (double v : ticks(y_lo, y_hi, false)) {
-    const int y = py(v);
-    cv::line(img, {left, y}, {width - right, y}, grey, 1);
-    cv::putText(img, tick_text(v), {8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
-  }
-  cv::rectangle(img, {left, top}, {width - right, height - bottom}, black, 1);
-  cv::putText(img, plot.x_label, {left + 150, height - 25}, cv::FONT_HERSHEY_SIMPLEX, 0.55, black);
-  cv::putText(img, plot.y_label, {8, top - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.55, black);
-  cv::putText(img, plot.title, {left + 120, 28}, cv::FONT_HERSHEY_SIMPLEX, 0.7, black, 2);
+  const size_t legend_lines = legend_texts.size() + plot.notes.size() + numbered.size();
+  const double height = std::max(top + plot_h + bottom, top + 10 + line_height * legend_lines + 10);
+  const double width = left + plot_w + 24 + 30 + legend_width + 16;
+  auto canvas = std::make_unique<Canvas>(static_cast<int>(std::ceil(width)), static_cast<int>(std::ceil(height)));
+  Canvas& c = *canvas;
 
-  int legend_y = top + 10;
-  auto legend = [&](const std::string& text, const cv::Scalar& colour) {
-    cv::putText(img, text, {width - right + 12, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42, colour);
-    legend_y += 18;
+  c.text({area.x0 + plot_w / 2, 16 + probe.measure("Ag", kTitle).height() - 4}, plot.title, kTitle, Anchor::Centre);
+  c.vertical_text({14 + probe.measure("Ag", kAxis).height() / 2, area.y0 + plot_h / 2}, plot.y_label, kAxis);
+  c.text({area.x0 + plot_w / 2, height - 12}, plot.x_label, kAxis, Anchor::Centre);
+  for (double v : x_ticks) {
+    c.line({px(v), area.y0}, {px(v), area.y1}, kGrid);
+    tick_label(c, {px(v), area.y1 + 8 + probe.measure("Ag", kTick).height() - 3}, tick_text(v), Anchor::Centre);
+  }
+  for (double v : y_ticks) {
+    c.line({area.x0, py(v)}, {area.x1, py(v)}, kGrid);
+    tick_label(c, {area.x0 - 6, py(v) + 4}, tick_text(v), Anchor::Right);
+  }
+  c.rectangle(area, kFrame, false);
+
+  // The legend, right of the plot: a sample of each series' line or marker, then the notes.
+  const double lx = area.x1 + 24;
+  double ly = area.y0 + 10 + line_height / 2;
+  auto legend_text = [&](const std::string& text) {
+    c.text({lx + 30, ly + 4}, text, kLegend);
+    ly += line_height;
   };
   for (const auto& [y, text] : plot.horizontal_lines) {
-    cv::line(img, {left, py(y)}, {width - right, py(y)}, cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
-    legend("--- " + text, cv::Scalar(90, 90, 90));
+    c.line({area.x0, py(y)}, {area.x1, py(y)}, {120, 120, 120}, 1, true);
+    c.line({lx, ly}, {lx + 22, ly}, {120, 120, 120}, 1, true);
+    legend_text(text);
   }
+  for (const auto& link : plot.links) c.line({px(link.x0), py(link.y0)}, {px(link.x1), py(link.y1)}, {150, 150, 150}, 1.2, true);
   for (const auto& s : plot.series) {
-    const cv::Scalar colour = bgr(s.colour);
     if (s.connect && s.points.size() > 1) {
       auto sorted = s.points;
       std::sort(sorted.begin(), sorted.end(), [](const PlotPoint& a, const PlotPoint& b) { return a.x < b.x; });
-      for (size_t i = 1; i < sorted.size(); ++i)
-        cv::line(img, {px(sorted[i - 1].x), py(sorted[i - 1].y)}, {px(sorted[i].x), py(sorted[i].y)}, colour, 2,
-                 cv::LINE_AA);
+      std::vector<Point2> line;
+      for (const auto& p : sorted)
+        if (!(plot.log_x && p.x <= 0)) line.push_back({px(p.x), py(p.y)});
+      c.polyline(line, s.colour, 1.5);
     }
-    for (const auto& p : s.points) {
-      if (plot.log_x && p.x <= 0) continue;
-      const cv::Point at(px(p.x), py(p.y));
-      cv::circle(img, at, s.radius, colour, cv::FILLED, cv::LINE_AA);
-      if (!p.label.empty())
-        cv::putText(img, p.label, at + cv::Point(7, -6), cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
-    }
-    if (!s.name.empty()) legend(s.name, colour);
+    if (s.name.empty()) continue;
+    if (s.connect) c.line({lx, ly}, {lx + 22, ly}, s.colour, 1.5);
+    c.marker({lx + 11, ly}, s.marker, std::min(s.radius, 6.0), s.colour, s.filled);
+    legend_text(s.name);
   }
-  for (const auto& note : plot.notes) legend(note, black);
+  if (!plot.links.empty() && !plot.links_name.empty()) {
+    c.line({lx, ly}, {lx + 22, ly}, {150, 150, 150}, 1.2, true);
+    legend_text(plot.links_name);
+  }
+  for (const auto& note : plot.notes) legend_text(note);
+  for (const auto& n : numbered) legend_text(n);
 
-  write_png(path, img);
+  for (const auto& s : plot.series)
+    for (const auto& p : s.points)
+      if (!(plot.log_x && p.x <= 0)) c.marker({px(p.x), py(p.y)}, s.marker, s.radius, s.colour, s.filled);
+  for (const auto& l : placed) {
+    if (l.leader) c.line(l.at, nearest_on(l.box, l.at), kLeader, 0.8);
+    c.text({l.box.x0, l.box.y1 - probe.measure(l.text, kLabel).y1}, l.text, kLabel);
+  }
+  return canvas;
 }
 
-void write_bar_chart(const std::filesystem::path& path, const BarChart& chart) {
+void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot) {
+  draw_scatter_plot(plot)->save(path);
+}
+
+std::unique_ptr<Canvas> draw_bar_chart(const BarChart& chart) {
   std::vector<double> ys = {0.0};
   for (const auto& s : chart.series) {
     if (s.values.size() != chart.categories.size())
-      throw Error(path.string(), "bar series '" + s.name + "' has " + std::to_string(s.values.size()) +
-                                     " values for " + std::to_string(chart.categories.size()) + " categories");
+      throw Error("bar chart '" + chart.title + "'", "series '" + s.name + "' has " + std::to_string(s.values.size()) +
+                                                         " values for " + std::to_string(chart.categories.size()) +
+                                                         " categories");
     for (const auto* v : {&s.values, &s.low, &s.high})
       for (double y : *v)
         if (std::isfinite(y)) ys.push_back(y);
   }
-  if (chart.categories.empty() || chart.series.empty()) throw Error(path.string(), "nothing to plot");
-  const double lo = *std::min_element(ys.begin(), ys.end()), hi = *std::max_element(ys.begin(), ys.end());
-  const double margin = hi > lo ? 0.08 * (hi - lo) : 0.5, y_lo = lo - margin, y_hi = hi + margin;
+  if (chart.categories.empty() || chart.series.empty()) throw Error("bar chart '" + chart.title + "'", "nothing to plot");
+  const auto [y_lo, y_hi] = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
+  const auto y_ticks = ticks(y_lo, y_hi, false);
 
-  const int group = std::max(60, 22 * static_cast<int>(chart.series.size()) + 24);
-  // Room below the axis for the longest category name, written downwards.
-  int longest = 0;
-  for (const auto& name : chart.categories)
-    longest = std::max(longest, cv::getTextSize(name, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, nullptr).width);
-  const int left = 80, right = 220, top = 50, bottom = std::max(150, longest + 24);
-  const int width = left + right + group * static_cast<int>(chart.categories.size()), height = 410 + bottom;
-  auto py = [&](double y) { return static_cast<int>(height - bottom - (y - y_lo) / (y_hi - y_lo) * (height - top - bottom)); };
+  Canvas probe(1, 1);
+  double y_tick_width = 0, longest = 0, legend_width = 0;
+  for (double v : y_ticks) y_tick_width = std::max(y_tick_width, probe.measure(tick_text(v), kTick).width());
+  for (const auto& name : chart.categories) longest = std::max(longest, probe.measure(name, kTick).width());
+  for (const auto& s : chart.series) legend_width = std::max(legend_width, probe.measure(s.name, kLegend).width());
+  const double line_height = probe.measure("Ag", kLegend).height() + 5;
+  const double group = std::max(60.0, 22.0 * chart.series.size() + 24);
+  const double plot_w = group * chart.categories.size(), plot_h = 360;
+  const double left = 14 + probe.measure("Ag", kAxis).height() + 10 + y_tick_width + 8;
+  const double top = 16 + probe.measure("Ag", kTitle).height() + 14;
+  const double bottom = longest + 16;  // category names read upwards under their group
+  const Box area{left, top, left + plot_w, top + plot_h};
+  const double title_width = probe.measure(chart.title, kTitle).width();
+  const double width = std::max(left + plot_w + 24 + 22 + legend_width + 16, left + title_width + 16);
+  const double height = std::max(top + plot_h + bottom, top + 10 + line_height * chart.series.size() + 10);
+  auto canvas = std::make_unique<Canvas>(static_cast<int>(std::ceil(width)), static_cast<int>(std::ceil(height)));
+  Canvas& c = *canvas;
+  auto py = [&, y_lo = y_lo, y_hi = y_hi](double y) { return area.y1 - (y - y_lo) / (y_hi - y_lo) * plot_h; };
 
-  cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const cv::Scalar black(0, 0, 0), grey(215, 215, 215);
-  for (double v : ticks(y_lo, y_hi, false)) {
-    cv::line(img, {left, py(v)}, {width - right, py(v)}, grey, 1);
-    cv::putText(img, tick_text(v), {8, py(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black);
+  c.text({left, 16 + probe.measure("Ag", kTitle).height() - 4}, chart.title, kTitle);
+  c.vertical_text({14 + probe.measure("Ag", kAxis).height() / 2, area.y0 + plot_h / 2}, chart.y_label, kAxis);
+  for (double v : y_ticks) {
+    c.line({area.x0, py(v)}, {area.x1, py(v)}, kGrid);
+    tick_label(c, {area.x0 - 6, py(v) + 4}, tick_text(v), Anchor::Right);
   }
-  cv::line(img, {left, py(0)}, {width - right, py(0)}, black, 1);
-  cv::rectangle(img, {left, top}, {width - right, height - bottom}, black, 1);
-  cv::putText(img, chart.y_label, {8, top - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.55, black);
-  cv::putText(img, chart.title, {left + 20, 28}, cv::FONT_HERSHEY_SIMPLEX, 0.7, black, 2);
+  c.line({area.x0, py(0)}, {area.x1, py(0)}, kBlack);
+  c.rectangle(area, kFrame, false);
 
-  const int bar = (group - 24) / static_cast<int>(chart.series.size());
-  for (size_t c = 0; c < chart.categories.size(); ++c) {
-    const int x0 = left + static_cast<int>(c) * group + 12;
-    for (size_t k = 0; k < chart.series.size(); ++k) {
-      const auto& s = chart.series[k];
-      const double v = s.values[c];
+  const double bar = (group - 24) / chart.series.size();
+  for (size_t k = 0; k < chart.categories.size(); ++k) {
+    const double x0 = area.x0 + k * group + 12;
+    for (size_t i = 0; i < chart.series.size(); ++i) {
+      const auto& s = chart.series[i];
+      const double v = s.values[k];
       if (!std::isfinite(v)) continue;
-      const int xa = x0 + static_cast<int>(k) * bar, xb = xa + bar - 2;
-      cv::rectangle(img, {xa, std::min(py(0), py(v))}, {xb, std::max(py(0), py(v))}, bgr(s.colour), cv::FILLED);
-      if (c < s.low.size() && c < s.high.size() && std::isfinite(s.low[c]) && std::isfinite(s.high[c])) {
-        const int xm = (xa + xb) / 2;
-        cv::line(img, {xm, py(s.low[c])}, {xm, py(s.high[c])}, black, 1);
-        cv::line(img, {xm - 3, py(s.low[c])}, {xm + 3, py(s.low[c])}, black, 1);
-        cv::line(img, {xm - 3, py(s.high[c])}, {xm + 3, py(s.high[c])}, black, 1);
+      const double xa = x0 + i * bar, xb = xa + bar - 2;
+      c.rectangle({xa, std::min(py(0), py(v)), xb, std::max(py(0), py(v))}, s.colour, true);
+      if (k < s.low.size() && k < s.high.size() && std::isfinite(s.low[k]) && std::isfinite(s.high[k])) {
+        const double xm = (xa + xb) / 2;
+        c.line({xm, py(s.low[k])}, {xm, py(s.high[k])}, kBlack);
+        c.line({xm - 3, py(s.low[k])}, {xm + 3, py(s.low[k])}, kBlack);
+        c.line({xm - 3, py(s.high[k])}, {xm + 3, py(s.high[k])}, kBlack);
       }
     }
-    // Category names run downwards at 90 degrees: drawn on a strip, then rotated.
-    const std::string& name = chart.categories[c];
-    cv::Mat strip(group - 8, bottom - 10, CV_8UC3, cv::Scalar(255, 255, 255));
-    cv::putText(strip, name, {4, (group - 8) / 2 + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
-    cv::Mat turned;
-    cv::rotate(strip, turned, cv::ROTATE_90_CLOCKWISE);
-    turned.copyTo(img(cv::Rect(x0 - 8, height - bottom + 6, turned.cols, turned.rows)));
+    const double name_width = probe.measure(chart.categories[k], kTick).width();
+    c.vertical_text({area.x0 + k * group + group / 2, area.y1 + 8 + name_width / 2}, chart.categories[k], kTick);
   }
-  int legend_y = top + 10;
+  double ly = area.y0 + 10 + line_height / 2;
   for (const auto& s : chart.series) {
-    cv::rectangle(img, {width - right + 12, legend_y - 10}, {width - right + 24, legend_y}, bgr(s.colour), cv::FILLED);
-    cv::putText(img, s.name, {width - right + 30, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
-    legend_y += 18;
+    const double lx = area.x1 + 24;
+    c.rectangle({lx, ly - 6, lx + 12, ly + 6}, s.colour, true);
+    c.text({lx + 22, ly + 4}, s.name, kLegend);
+    ly += line_height;
   }
-  write_png(path, img);
+  return canvas;
 }
+
+void write_bar_chart(const std::filesystem::path& path, const BarChart& chart) { draw_bar_chart(chart)->save(path); }
 
 }  // namespace cgsr

@@ -1,15 +1,17 @@
 #pragma once
-// Plots as PNG (OpenCV drawing): scatter plots of quality against cost for reports and search
-// histories, grouped bar charts with error bars for ablations.
+// Plots on a Canvas (Cairo; PNG, SVG or PDF by the file's extension): scatter plots of quality
+// against cost for reports and search histories, grouped bar charts with error bars for
+// ablations. Every point label is placed where it overlaps no other text or marker and stays
+// inside the plot; one that finds no such place is numbered and spelled out in the legend.
 
-#include <array>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
-namespace cgsr {
+#include "core/canvas.h"
 
-using Rgb = std::array<int, 3>;
+namespace cgsr {
 
 struct PlotPoint {
   double x = 0, y = 0;
@@ -17,11 +19,18 @@ struct PlotPoint {
 };
 
 struct PlotSeries {
-  std::string name;  // legend entry
+  std::string name;  // legend entry; "" for none
   Rgb colour{40, 90, 180};
-  int radius = 5;
+  double radius = 5;
   bool connect = false;  // draw a polyline through the points (sorted by x)
+  Marker marker = Marker::Circle;
+  bool filled = true;
   std::vector<PlotPoint> points;
+};
+
+// A dashed line joining two points (say, a network and its control).
+struct PlotLink {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
 struct ScatterPlot {
@@ -29,10 +38,14 @@ struct ScatterPlot {
   bool log_x = false;
   std::vector<PlotSeries> series;
   std::vector<std::pair<double, std::string>> horizontal_lines;  // y value and legend text
-  std::vector<std::string> notes;                               // extra legend lines
+  std::vector<PlotLink> links;
+  std::string links_name;          // legend entry of the links
+  std::vector<std::string> notes;  // extra legend lines
 };
 
-// Throws cgsr::Error naming the path when there is nothing to draw.
+// The drawn plot, for saving or for checking its layout. Throws cgsr::Error when there is
+// nothing to draw.
+std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot);
 void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot);
 
 struct BarSeries {
@@ -45,10 +58,11 @@ struct BarSeries {
 // Groups of bars, one group per category, one bar per series; the zero line is drawn.
 struct BarChart {
   std::string title, y_label;
-  std::vector<std::string> categories;  // written under their group, turned when long
+  std::vector<std::string> categories;  // written under their group, reading upwards
   std::vector<BarSeries> series;
 };
 
+std::unique_ptr<Canvas> draw_bar_chart(const BarChart& chart);
 void write_bar_chart(const std::filesystem::path& path, const BarChart& chart);
 
 }  // namespace cgsr

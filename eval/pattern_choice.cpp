@@ -46,8 +46,7 @@ std::string pattern_choice_markdown(const std::string& model, const PatternChoic
   return md.str() + "\n";
 }
 
-void write_pattern_choice_plot(const std::filesystem::path& path, const std::string& model,
-                               const PatternChoices& choices) {
+ScatterPlot pattern_choice_plot(const std::string& model, const PatternChoices& choices) {
   ScatterPlot plot;
   plot.title = model + ": pattern chosen per frame";
   plot.x_label = "geometry-edge pixels of the frame (%)";
@@ -66,10 +65,10 @@ void write_pattern_choice_plot(const std::filesystem::path& path, const std::str
     it->second.points.push_back({100.0 * *c.edge_fraction, 100.0 * c.channel_fraction, std::to_string(c.frame)});
   }
   if (series.empty())
-    throw Error(path.string(), "no frame of " + model + " has an edge density (the data set has no edge channel)");
+    throw Error(model, "no frame of " + model + " has an edge density (the data set has no edge channel)");
   for (auto& [pattern, s] : series) plot.series.push_back(std::move(s));
   plot.notes.push_back("labels: frame numbers");
-  write_scatter_plot(path, plot);
+  return plot;
 }
 
 }  // namespace cgsr

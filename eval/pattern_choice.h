@@ -5,7 +5,7 @@
 // geometry-edge density, how hard the rendering information says the frame is, as a table and
 // a plot; the verdict counts the patterns in use.
 //
-//   if (auto c = pattern_choices(result)) write_pattern_choice_plot("choice.png", result.name, *c);
+//   if (auto c = pattern_choices(result)) write_scatter_plot("choice.svg", pattern_choice_plot(result.name, *c));
 
 #include <filesystem>
 #include <map>
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/plot.h"
 #include "eval/evaluation.h"
 
 namespace cgsr {
@@ -41,9 +42,9 @@ std::string usage_text(const PatternChoices& choices);
 std::string pattern_choice_markdown(const std::string& model, const PatternChoices& choices,
                                     const std::string& plot = "");
 
-// Per frame, the chosen pattern's channel fraction against the frame's edge density (PNG).
-// Throws cgsr::Error when no frame has an edge density (the data set has no edge channel).
-void write_pattern_choice_plot(const std::filesystem::path& path, const std::string& model,
-                               const PatternChoices& choices);
+// Per frame, the chosen pattern's channel fraction against the frame's edge density, each point
+// named by its frame. Throws cgsr::Error when no frame has an edge density (the data set has no
+// edge channel).
+ScatterPlot pattern_choice_plot(const std::string& model, const PatternChoices& choices);
 
 }  // namespace cgsr

@@ -9,9 +9,9 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/pareto.h"
-#include "core/plot.h"
 #include "core/text.h"
 #include "eval/pattern_choice.h"
+#include "eval/report_page.h"
 
 namespace cgsr {
 namespace {
@@ -23,16 +23,13 @@ std::string csv_field(const std::string& text) {
   return quoted + "\"";
 }
 
-struct Cells {
-  std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
-};
-
 std::string optional_fixed(std::optional<double> v, int digits, const std::string& none) {
   return v ? fixed(*v, digits) : none;
 }
+}  // namespace
 
-Cells cells(const EvalResult& r) {
-  Cells c;
+ReportCells report_cells(const EvalResult& r) {
+  ReportCells c;
   c.params = r.cost ? fixed(r.cost->params / 1000.0, 1) : "NA";
   c.macs = r.cost ? fixed(r.cost->macs / 1e9, 2) : "NA";
   c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
@@ -44,7 +41,6 @@ Cells cells(const EvalResult& r) {
   c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
   return c;
 }
-}  // namespace
 
 std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
   std::vector<ReportTable> tables;
@@ -94,7 +90,7 @@ std::string report_markdown(const ReportTable& table) {
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
-    const auto c = cells(r);
+    const auto c = report_cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | "
        << (timed ? c.latency + " | " : "") << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
@@ -136,28 +132,40 @@ std::string report_csv(const std::vector<ReportTable>& tables) {
   return csv.str();
 }
 
-void write_report_plot(const std::filesystem::path& path, const ReportTable& table) {
+ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles) {
   ScatterPlot plot;
   plot.title = table.dataset + " x" + std::to_string(table.scale) + ": PSNR against latency";
   plot.x_label = "latency (ms, median, log scale)";
   plot.y_label = "PSNR (dB)";
   plot.log_x = true;
-  const auto front = pareto_front(table);
-  PlotSeries others{"upscaler", {40, 90, 180}, 5, false, {}}, best{"Pareto front", {220, 40, 40}, 6, true, {}};
+  auto named = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  PlotSeries classic{"classic upscaler", {120, 120, 120}, 5, false, Marker::Triangle, true, {}};
+  PlotSeries network{"network", {40, 90, 180}, 5, false, Marker::Circle, true, {}};
+  PlotSeries control{"control", {40, 90, 180}, 5, false, Marker::Square, false, {}};
+  PlotSeries final_net{"final network", {210, 40, 40}, 6.5, false, Marker::Diamond, true, {}};
+  PlotSeries front{"Pareto front", {210, 40, 40}, 0, true, Marker::Circle, true, {}};
+  std::map<std::string, std::pair<double, double>> at;  // row name -> (latency, PSNR)
+  const auto on_front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
-    const std::string label = std::to_string(i + 1);
-    plot.notes.push_back(label + ". " + r.name + " " + fixed(r.psnr, 2) + " dB" +
-                         (r.psnr_edge ? " (edges " + fixed(*r.psnr_edge, 2) + " dB)" : ""));
     if (!r.latency) {
       plot.horizontal_lines.emplace_back(r.psnr, r.name + " (no latency)");
       continue;
     }
-    const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-    (on_front ? best : others).points.push_back({r.latency->median_ms, r.psnr, label});
+    const PlotPoint p{r.latency->median_ms, r.psnr, r.name};
+    at[r.name] = {p.x, p.y};
+    (named(roles.finals, r.name) ? final_net : named(roles.controls, r.name) ? control : !r.cost ? classic : network)
+        .points.push_back(p);
+    if (std::find(on_front.begin(), on_front.end(), i) != on_front.end()) front.points.push_back({p.x, p.y, ""});
   }
-  plot.series = {others, best};
-  write_scatter_plot(path, plot);
+  for (const auto& [a, b] : roles.pairs)
+    if (at.count(a) && at.count(b)) plot.links.push_back({at[a].first, at[a].second, at[b].first, at[b].second});
+  plot.links_name = "a network and its control";
+  for (auto* s : {&front, &classic, &network, &control, &final_net})
+    if (!s->points.empty()) plot.series.push_back(*s);
+  return plot;
 }
 
 std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs) {
@@ -180,11 +188,19 @@ std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs
 }
 
 nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
-                                    const std::vector<std::string>& heldout_scenes) {
+                                    const std::vector<std::string>& heldout_scenes, const ReportRoles& roles,
+                                    const std::vector<ComparisonImage>& comparisons) {
   const auto tables = group_results(evaluations);
   std::string markdown;
   nlohmann::ordered_json results;
   results["tables"] = nlohmann::ordered_json::array();
+  results["pattern_choices"] = nlohmann::ordered_json::array();
+  // Each plot as PNG for the Markdown report and as SVG for the page.
+  const auto save_plot = [&](const std::string& stem, const ScatterPlot& plot) {
+    const auto canvas = draw_scatter_plot(plot);
+    canvas->save(run_dir.file(stem + ".png"));
+    canvas->save(run_dir.file(stem + ".svg"));
+  };
   for (const auto& t : tables) {
     const bool heldout = std::find(heldout_scenes.begin(), heldout_scenes.end(), t.dataset) != heldout_scenes.end();
     if (heldout)
@@ -195,34 +211,51 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
     // A plot of PSNR against latency needs a latency (held-out scenes are evaluated for quality only).
     std::string plot;
     if (std::any_of(t.rows.begin(), t.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); })) {
-      plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale) + ".png";
-      write_report_plot(run_dir.file(plot), t);
-      markdown += "![PSNR against latency](" + plot + ")\n\n";
+      plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale);
+      save_plot(plot, report_plot(t, roles));
+      markdown += "![PSNR against latency](" + plot + ".png)\n\n";
     }
-    results["tables"].push_back(
-        {{"dataset", t.dataset}, {"scale", t.scale}, {"rows", t.rows.size()}, {"plot", plot}, {"heldout", heldout}});
+    results["tables"].push_back({{"dataset", t.dataset},
+                                 {"scale", t.scale},
+                                 {"rows", t.rows.size()},
+                                 {"plot", plot.empty() ? "" : plot + ".png"},
+                                 {"plot_svg", plot.empty() ? "" : plot + ".svg"},
+                                 {"heldout", heldout}});
     // Models that choose a pattern per frame: the choice next to each frame's edge density.
     for (size_t i = 0; i < t.rows.size(); ++i) {
       const auto choices = pattern_choices(t.rows[i]);
       if (!choices) continue;
-      std::string choice_plot = "pattern_choice_" + t.dataset + "_x" + std::to_string(t.scale) + "_" +
-                                std::to_string(i + 1) + ".png";
+      std::string choice_plot = "pattern_choice_" + t.dataset + "_x" + std::to_string(t.scale) + "_" + std::to_string(i + 1);
       const bool has_edges = std::any_of(choices->frames.begin(), choices->frames.end(),
                                          [](const FrameChoice& c) { return c.edge_fraction.has_value(); });
       if (has_edges)
-        write_pattern_choice_plot(run_dir.file(choice_plot), t.rows[i].name, *choices);
+        save_plot(choice_plot, pattern_choice_plot(t.rows[i].name, *choices));
       else
         choice_plot.clear();
-      markdown += pattern_choice_markdown(t.rows[i].name, *choices, choice_plot);
-      results["pattern_choices"].push_back(
-          {{"model", t.rows[i].name}, {"patterns_used", choices->usage.size()}, {"plot", choice_plot}});
+      markdown += pattern_choice_markdown(t.rows[i].name, *choices, choice_plot.empty() ? "" : choice_plot + ".png");
+      results["pattern_choices"].push_back({{"dataset", t.dataset},
+                                            {"scale", t.scale},
+                                            {"model", t.rows[i].name},
+                                            {"patterns_used", choices->usage.size()},
+                                            {"plot", choice_plot.empty() ? "" : choice_plot + ".png"},
+                                            {"plot_svg", choice_plot.empty() ? "" : choice_plot + ".svg"}});
     }
+  }
+  if (!comparisons.empty()) {
+    markdown += "## Image comparisons\n\nThe same crop of each upscaler's output, where the networks differ most from "
+                "bicubic, and each one's absolute error on one colour scale.\n\n";
+    for (const auto& c : comparisons)
+      markdown += "### " + c.dataset + ", frame " + std::to_string(c.frame) + "\n\n![crops](images/" + c.crops +
+                  ")\n\n![error maps](images/" + c.errors + ")\n\n";
   }
   write_file_atomic(run_dir.file("report.md"), markdown);
   write_file_atomic(run_dir.file("report.csv"), report_csv(tables));
   std::printf("%s", markdown.c_str());
+  results["comparisons"] = nlohmann::ordered_json::array();
+  for (const auto& c : comparisons) results["comparisons"].push_back(to_json(c));
   results["evaluations"] = nlohmann::ordered_json::array();
   for (const auto& e : evaluations) results["evaluations"].push_back(to_json(e));
+  write_report_page(run_dir.path(), results);
   return results;
 }
 

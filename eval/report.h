@@ -6,16 +6,18 @@
 //
 // The report of run directories (`cgsr report`, the report stage of `cgsr run`): the
 // evaluations of their results.json files, collected, written as report.md, report.csv, a plot
-// per table, and a pattern-choice section per model that chooses a pattern per frame
-// (pattern_choice.h).
+// per table, a pattern-choice section per model that chooses a pattern per frame
+// (pattern_choice.h), image comparisons when given, and the same as one HTML page.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "core/plot.h"
 #include "core/run_dir.h"
 #include "eval/evaluation.h"
+#include "eval/image_comparison.h"
 
 namespace cgsr {
 
@@ -28,24 +30,42 @@ struct ReportTable {
 // Groups results by (dataset, scale), keeping their order within each group.
 std::vector<ReportTable> group_results(const std::vector<EvalResult>& results);
 
+// A row's figures as the tables print them ("-" or "NA" where there is none).
+struct ReportCells {
+  std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
+};
+ReportCells report_cells(const EvalResult& r);
+
 std::string report_markdown(const ReportTable& table);
 std::string report_csv(const std::vector<ReportTable>& tables);
 
 // Indices of rows on the Pareto front: no other row is both faster and at least as good (PSNR).
 std::vector<size_t> pareto_front(const ReportTable& table);
 
-// Writes a PSNR-against-latency scatter plot (PNG); rows without latency are drawn as lines
-// across the plot at their PSNR.
-void write_report_plot(const std::filesystem::path& path, const ReportTable& table);
+// What rows are, for the plot: final networks and controls are drawn apart from the other
+// networks, and each network is joined to its controls. Rows named in neither list are networks,
+// or classic upscalers when they have no parameter count.
+struct ReportRoles {
+  std::vector<std::string> finals, controls;
+  std::vector<std::pair<std::string, std::string>> pairs;  // (network, one of its controls)
+};
+
+// PSNR against latency, each point named; rows without latency are lines across the plot at
+// their PSNR.
+ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles = {});
 
 // Every evaluation found in the given run directories / results files (results.json of
 // `cgsr eval`, `cgsr prune` or `cgsr report`), in order.
 std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs);
 
-// Writes report.md, report.csv and one plot per (scene, scale) into `run_dir` and prints the
-// tables; the results it returns carry the evaluations again, so a report can be reported on.
-// The tables of `heldout_scenes` (data set names) are headed as scenes not in the training data.
+// Writes report.md, report.csv, index.html (report_page.h) and one plot per (scene, scale), as
+// PNG and SVG, into `run_dir`, and prints the tables; the results it returns carry the
+// evaluations again, so a report can be reported on. The tables of `heldout_scenes` (data set
+// names) are headed as scenes not in the training data. `comparisons` were written into
+// run_dir/images (image_comparison.h).
 nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
-                                    const std::vector<std::string>& heldout_scenes = {});
+                                    const std::vector<std::string>& heldout_scenes = {},
+                                    const ReportRoles& roles = {},
+                                    const std::vector<ComparisonImage>& comparisons = {});
 
 }  // namespace cgsr

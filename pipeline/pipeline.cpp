@@ -13,6 +13,7 @@
 #include "core/timing.h"
 #include "core/yaml_json.h"
 #include "eval/report.h"
+#include "eval/report_page.h"
 #include "export/exporter.h"
 #include "export/hybrid_export.h"
 #include "export/onnx_writer.h"
@@ -71,6 +72,9 @@ config::Schema<PipelineOptions> pipeline_schema() {
   s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames; latency_runs: rounds of the report's side-by-side timing)");
   s.section("heldout", &PipelineOptions::heldout, heldout_schema(),
             "scenes not in the training data, on which every model and classic baseline is evaluated");
+  s.section("images", &PipelineOptions::images, comparison_schema_fields(),
+            "the report's image comparisons: crops and error maps of the test frames with the most geometry edges "
+            "and of a frame of each held-out scene");
   s.section("verdict", &PipelineOptions::verdict, verdict_schema(), "what the run must show");
   s.field("from", &PipelineOptions::from, "rerun this stage and every later one").check(
       [](const std::string& v) {
@@ -250,6 +254,9 @@ class Pipeline {
     const Verdict verdict = judge();
     write_file_atomic(root_ / "verdict.txt", verdict.text());
     results_["verdict"] = verdict.to_json();
+    // The page again, now with the verdict's checks at its top.
+    write_report_page(stages_.dir("report"), nlohmann::ordered_json::parse(read_file(stages_.dir("report") / "results.json")),
+                      results_["verdict"]);
     results_["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     write_file_atomic(root_ / "results.json", results_.dump(2) + "\n");
 
@@ -588,16 +595,79 @@ class Pipeline {
     report_runs.insert(report_runs.end(), heldout_runs.begin(), heldout_runs.end());
     std::vector<std::string> upstream = {evaluated_.hash, pruned_.hash, exported_.hash};
     if (!heldout_runs.empty()) upstream.push_back(heldout_.hash);
-    const auto reported = stages_.run(
-        "report", YAML::Node(report_runs), upstream, [&](RunDir& dir, bool) {
-          std::vector<EvalResult> evaluations = collect_evaluations(runs);
-          if (eval_.latency_runs > 0) time_side_by_side(evaluations);
-          const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
-          evaluations.insert(evaluations.end(), unseen.begin(), unseen.end());
-          return write_report(evaluations, dir, heldout_scenes(heldout_.summary));
-        });
+    YAML::Node config(YAML::NodeType::Map);
+    config["runs"] = report_runs;
+    config["images"] = comparison_schema_fields().emit(options_.images);
+    const auto reported = stages_.run("report", config, upstream, [&](RunDir& dir, bool) {
+      std::vector<EvalResult> evaluations = collect_evaluations(runs);
+      const auto upscalers = report_upscalers(evaluations);
+      if (eval_.latency_runs > 0) time_side_by_side(evaluations, upscalers);
+      const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
+      const auto comparisons = compare_images(evaluations, unseen, upscalers, dir.path() / "images");
+      evaluations.insert(evaluations.end(), unseen.begin(), unseen.end());
+      return write_report(evaluations, dir, heldout_scenes(heldout_.summary), report_roles(), comparisons);
+    });
     record("report", reported);
     if (reported.skipped) std::printf("%s", read_file(stages_.dir("report") / "report.md").c_str());
+  }
+
+  // Which rows are final networks and controls, and which control belongs to which network.
+  ReportRoles report_roles() const {
+    ReportRoles r;
+    const std::string enhanced = enhanced_stage_.summary.at("name").get<std::string>();
+    r.finals = {roles_.input.name, roles_.hybrid.name};
+    r.controls = {control_.name};
+    r.pairs = {{enhanced, control_.name}};
+    for (const auto& c : control_models()) {
+      r.controls.push_back(c.name);
+      r.pairs.emplace_back(roles_.input.name, c.name);
+    }
+    return r;
+  }
+
+  // The upscaler of every row, in order: classic ones by name, networks from their files.
+  std::vector<std::unique_ptr<Upscaler>> report_upscalers(const std::vector<EvalResult>& evaluations) const {
+    const auto files = model_files();
+    std::vector<std::unique_ptr<Upscaler>> upscalers;
+    for (const auto& e : evaluations) {
+      const auto file = files.find(e.name);
+      if (e.name == roles_.static_network.name)
+        upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(model_file("prune")).network));
+      else
+        upscalers.push_back(
+            make_upscaler(file == files.end() ? e.name : file->second.string(), e.name, backbone_.scale));
+    }
+    return upscalers;
+  }
+
+  // Crops and error maps of every network: on the test frames with the most geometry edges and
+  // on the frame with the most of each held-out scene.
+  std::vector<ComparisonImage> compare_images(const std::vector<EvalResult>& own, const std::vector<EvalResult>& unseen,
+                                              const std::vector<std::unique_ptr<Upscaler>>& upscalers,
+                                              const fs::path& dir) const {
+    std::vector<ComparisonImage> out;
+    if (options_.images.frames == 0) return out;
+    std::vector<Upscaler*> networks;
+    for (size_t i = 0; i < own.size(); ++i)
+      if (!classic_upscalers().contains(own[i].name)) networks.push_back(upscalers[i].get());
+    const EvalResult* bicubic = find_result(own, "bicubic");
+    if (!bicubic || networks.empty()) return out;
+    for (int frame : frames_with_most_edges(*bicubic, options_.images.frames)) {
+      spdlog::info("report: image comparison of {} frame {}", data_->info().name, frame);
+      out.push_back(compare_frame(networks, *data_, frame, options_.images, dir));
+    }
+    const auto scenes = heldout_scenes(heldout_.summary);
+    for (size_t k = 0; k < scenes.size(); ++k) {
+      const auto row = std::find_if(unseen.begin(), unseen.end(),
+                                    [&](const EvalResult& e) { return e.dataset == scenes[k] && e.name == "bicubic"; });
+      if (row == unseen.end()) continue;
+      const Dataset level = Dataset::open(heldout_.summary.at("scenes").at(k).at("data").get<std::string>());
+      for (int frame : frames_with_most_edges(*row, 1)) {
+        spdlog::info("report: image comparison of {} frame {}", scenes[k], frame);
+        out.push_back(compare_frame(networks, level, frame, options_.images, dir));
+      }
+    }
+    return out;
   }
 
   // Every row's model file by its display name (the static network is read from the hybrid
@@ -614,28 +684,22 @@ class Pipeline {
     return files;
   }
 
-  void time_side_by_side(std::vector<EvalResult>& evaluations) const {
+  void time_side_by_side(std::vector<EvalResult>& evaluations,
+                         const std::vector<std::unique_ptr<Upscaler>>& upscalers) const {
     const auto files = model_files();
     std::map<std::string, fs::path> onnx_files;  // each row's exported ONNX file
     for (const auto& [name, file] : files) {
       const auto onnx = onnx_of_file_.find(file.string());
       if (onnx != onnx_of_file_.end() && name != roles_.hybrid.name) onnx_files[name] = onnx->second;
     }
-    std::vector<std::unique_ptr<Upscaler>> upscalers;
     std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
     std::vector<Batch> frames;              // per model, the first of them
     std::vector<std::function<void()>> timed;
     // The frames the rows were evaluated on (of a scene set, e.g. one scene's), not the whole split:
     // a hybrid's latency follows the patterns its frames choose.
     const std::vector<int> test_frames = evaluation_frames(*data_, eval_);
-    for (const auto& e : evaluations) {
-      const auto file = files.find(e.name);
-      if (e.name == roles_.static_network.name)
-        upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(model_file("prune")).network));
-      else
-        upscalers.push_back(
-            make_upscaler(file == files.end() ? e.name : file->second.string(), e.name, backbone_.scale));
-      sequences.push_back(timing_sequence(*data_, test_frames, backbone_.scale, *upscalers.back(), eval_.latency_runs));
+    for (const auto& u : upscalers) {
+      sequences.push_back(timing_sequence(*data_, test_frames, backbone_.scale, *u, eval_.latency_runs));
       frames.push_back(sequences.back().frames.front());
     }
     for (size_t i = 0; i < upscalers.size(); ++i)

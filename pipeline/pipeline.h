@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "eval/image_comparison.h"
 #include "export/export_format.h"
 #include "pipeline/controls_stage.h"
 #include "pipeline/heldout_evaluation.h"
@@ -62,6 +63,7 @@ struct PipelineOptions : RunSettings {
   std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
   config::Block eval;                // EvalOptions shared by the eval and prune stages
   HeldoutOptions heldout;            // scenes never trained on, evaluated with every model
+  ComparisonOptions images;          // crops and error maps in the report
   VerdictOptions verdict;
   std::string from;                  // rerun this stage and every later one
 };

@@ -54,16 +54,18 @@ void write_front_plot(const std::filesystem::path& path, const std::vector<Searc
   const std::vector<Rgb> dots = {{120, 160, 230}, {190, 190, 190}}, lines = {{30, 70, 170}, {110, 110, 110}};
   for (size_t r = 0; r < runs.size(); ++r) {
     PlotSeries all{runs[r].strategy + " (" + std::to_string(runs[r].result.evaluated.size()) + " subnets)", dots[r % 2],
-                   2, false, {}};
+                   2, false, Marker::Circle, true, {}};
     for (const auto& c : runs[r].result.evaluated)
       if (!c.failed) all.points.push_back({c.score.latency_ms, c.quality, ""});
-    PlotSeries front{runs[r].strategy + " front", lines[r % 2], 4, true, {}};
+    PlotSeries front{runs[r].strategy + " front", lines[r % 2], 4, true, Marker::Circle, true, {}};
     for (const auto& c : runs[r].result.front) front.points.push_back({c.score.latency_ms, c.quality, ""});
     plot.series.push_back(all);
     plot.series.push_back(front);
   }
-  plot.series.push_back({"full network", {20, 20, 20}, 7, false, {{full.score.latency_ms, full.quality, "full"}}});
-  plot.series.push_back({"pick", {220, 40, 40}, 7, false, {{pick.score.latency_ms, pick.quality, "pick"}}});
+  plot.series.push_back(
+      {"full network", {20, 20, 20}, 6, false, Marker::Square, true, {{full.score.latency_ms, full.quality, "full"}}});
+  plot.series.push_back(
+      {"pick", {220, 40, 40}, 7, false, Marker::Diamond, true, {{pick.score.latency_ms, pick.quality, "pick"}}});
   plot.notes.push_back("latency budget " + fmt::format("{:.1f}", budget_ms) + " ms");
   write_scatter_plot(path, plot);
 }

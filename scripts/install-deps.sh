@@ -15,12 +15,14 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libonnx-dev libprotobuf-dev protobuf-compiler   # ONNX export
   libzip-dev libstb-dev                           # pk3 archives, TGA textures
+  libcairo2-dev fonts-dejavu-core                 # plots and image grids (core/canvas.h), their font
   python3-torch                                   # torch.jit.load check of TorchScript exports
 )
-# Optional: clang with libFuzzer for fuzz/ (-DCGSR_FUZZ=ON), and the OpenArena game data (~400 MB)
-# for configs/scenes/oa_*.yaml; the tests need neither.
+# Optional: clang with libFuzzer for fuzz/ (-DCGSR_FUZZ=ON), Chromium for the test that opens a
+# report page in a real browser, and the OpenArena game data (~400 MB)
+# for configs/scenes/oa_*.yaml; the test suite runs without them (the browser test is then skipped).
 if [ "${1:-}" = "--with-optional" ]; then
-  packages+=(clang libclang-rt-dev openarena-088-data openarena-data)
+  packages+=(clang libclang-rt-dev chromium openarena-088-data openarena-data)
 fi
 # ONNX Runtime verification runs through the npm package onnxruntime-node; a machine
 # whose Node.js does not come from Debian already has npm.

@@ -39,7 +39,7 @@ TEST(PatternChoice, CountsThePatternsEachFrameChose) {
 
   const auto dir = std::filesystem::temp_directory_path() / "cgsr_test_pattern_choice";
   std::filesystem::create_directories(dir);
-  write_pattern_choice_plot(dir / "choice.png", r.name, *choices);
+  write_scatter_plot(dir / "choice.png", pattern_choice_plot(r.name, *choices));
   EXPECT_GT(read_image(dir / "choice.png").numel(), 0);
   std::filesystem::remove_all(dir);
 }
@@ -58,7 +58,7 @@ TEST(PatternChoice, APlotNeedsEdgeDensities) {
   const auto choices = pattern_choices(r);
   ASSERT_TRUE(choices);
   EXPECT_EQ(pattern_choice_markdown(r.name, *choices).find("!["), std::string::npos);
-  EXPECT_THROW(write_pattern_choice_plot(std::filesystem::temp_directory_path() / "never.png", r.name, *choices), Error);
+  EXPECT_THROW(pattern_choice_plot(r.name, *choices), Error);
 }
 
 TEST(PatternChoice, TravelsThroughResultsFilesInItsOwnShape) {

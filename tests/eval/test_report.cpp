@@ -97,13 +97,41 @@ TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
   EXPECT_NE(csv.find(",,,\n"), std::string::npos) << csv;  // bicubic: no ONNX Runtime, no edge figures
 }
 
-TEST(Report, PlotIsAPng) {
-  const auto path = std::filesystem::temp_directory_path() / "cgsr-report-plot.png";
+TEST(Report, PlotIsAPngAndAnSvg) {
+  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-plot";
   auto pan = row("pan", 33, 12.0, 261403);
   pan.psnr_edge = 28;
   ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), pan, row("fsr", 31, std::nullopt)}};
-  write_report_plot(path, t);
-  const auto bytes = read_file(path);
-  ASSERT_GT(bytes.size(), 1000u);
-  EXPECT_EQ(bytes.substr(1, 3), "PNG");
+  write_scatter_plot(dir / "plot.png", report_plot(t));
+  write_scatter_plot(dir / "plot.svg", report_plot(t));
+  const auto png = read_file(dir / "plot.png"), svg = read_file(dir / "plot.svg");
+  ASSERT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// Controls and final networks are drawn apart, each pair is joined, and every timed row is a
+// point named after its model.
+TEST(Report, PlotMarksRolesAndJoinsPairs) {
+  ReportTable t{"hall", 2,
+                {row("bicubic", 30, 0.5), row("pan", 33, 12.0, 261403), row("pan (control)", 33.1, 12.1, 261403),
+                 row("pan cg", 33.3, 12.5, 270000), row("slim", 33.2, 4.0, 70000)}};
+  ReportRoles roles;
+  roles.finals = {"slim"};
+  roles.controls = {"pan (control)"};
+  roles.pairs = {{"pan cg", "pan (control)"}, {"slim", "missing row"}};
+  const ScatterPlot plot = report_plot(t, roles);
+  std::map<std::string, std::string> series_of;
+  for (const auto& s : plot.series)
+    for (const auto& p : s.points)
+      if (!p.label.empty()) series_of[p.label] = s.name;
+  EXPECT_EQ(series_of.size(), 5u);
+  EXPECT_EQ(series_of["bicubic"], "classic upscaler");
+  EXPECT_EQ(series_of["pan"], "network");
+  EXPECT_EQ(series_of["pan (control)"], "control");
+  EXPECT_EQ(series_of["slim"], "final network");
+  ASSERT_EQ(plot.links.size(), 1u);  // a pair with a missing row is left out
+  EXPECT_DOUBLE_EQ(plot.links[0].x0, 12.5);
+  EXPECT_DOUBLE_EQ(plot.links[0].x1, 12.1);
 }
