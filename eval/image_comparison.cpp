@@ -79,13 +79,16 @@ std::unique_ptr<Canvas> tile_grid(const std::string& heading, const std::vector<
                                   const cv::Mat& colour_bar = {}, const std::string& bar_low = "",
                                   const std::string& bar_high = "") {
   Canvas probe(1, 1);
-  double column = tiles.front().image.cols;
-  for (const auto& t : tiles)
-    column = std::max({column, probe.measure(t.name, kName).width() + 8, probe.measure(t.figure, kFigure).width() + 8});
+  double column = 0, tile_h = 0;
+  for (const auto& t : tiles) {
+    column = std::max({column, double(t.image.cols), probe.measure(t.name, kName).width() + 8,
+                       probe.measure(t.figure, kFigure).width() + 8});
+    tile_h = std::max(tile_h, double(t.image.rows));
+  }
   const double text_h = probe.measure("Ag", kName).height() + probe.measure("Ag", kFigure).height() + 10;
   const double head_h = probe.measure("Ag", kHeading).height() + 16, gap = 10;
   const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
-  const double row_h = tiles.front().image.rows + text_h + gap;
+  const double row_h = tile_h + text_h + gap;
   const double bar_h = colour_bar.empty() ? 0 : colour_bar.rows + probe.measure("Ag", kFigure).height() + 16;
   const double width = std::max(gap + columns * (column + gap), probe.measure(heading, kHeading).width() + 2 * gap);
   auto canvas = std::make_unique<Canvas>(static_cast<int>(std::ceil(width)),
@@ -96,7 +99,7 @@ std::unique_ptr<Canvas> tile_grid(const std::string& heading, const std::vector<
     const double x = gap + (i % columns) * (column + gap), y = head_h + (i / columns) * row_h;
     const double cx = x + column / 2;
     c.image({cx - tiles[i].image.cols / 2.0, y}, tiles[i].image);
-    const double name_y = y + tiles[i].image.rows + probe.measure("Ag", kName).height();
+    const double name_y = y + tile_h + probe.measure("Ag", kName).height();
     c.text({cx, name_y}, tiles[i].name, kName, Anchor::Centre);
     c.text({cx, name_y + probe.measure("Ag", kFigure).height() + 2}, tiles[i].figure, kFigure, Anchor::Centre);
   }
@@ -119,11 +122,13 @@ cv::Mat colour_bar(int width, int height) {
 }
 }  // namespace
 
-cv::Point choose_crop(const std::vector<torch::Tensor>& outputs, const torch::Tensor& reference, int size) {
+cv::Point choose_crop(const std::vector<torch::Tensor>& outputs, const torch::Tensor& reference,
+                      const torch::Tensor& truth, int size) {
   const int h = static_cast<int>(reference.size(-2)), w = static_cast<int>(reference.size(-1));
-  if (size > w || size > h) return {0, 0};
+  if (size > w || size > h || outputs.empty()) return {0, 0};
+  const torch::Tensor reference_error = abs_difference(reference, truth);
   torch::Tensor difference = torch::zeros({h, w});
-  for (const auto& o : outputs) difference += abs_difference(o, reference);
+  for (const auto& o : outputs) difference += (reference_error - abs_difference(o, truth)).abs();
   cv::Mat integral;
   cv::integral(to_mat(difference), integral, CV_64F);
   const int step = std::max(1, size / 8);
@@ -193,10 +198,8 @@ ComparisonImage comparison_from_json(const nlohmann::ordered_json& j, const std:
   }
 }
 
-ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Dataset& data, int frame,
+ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Dataset& data, int frame, int scale,
                               const ComparisonOptions& options, const std::filesystem::path& dir) {
-  if (networks.empty()) throw Error("image comparison", "needs at least one network", ErrorKind::Internal);
-  const int scale = networks.front()->scale();
   std::vector<std::unique_ptr<Upscaler>> classic;
   for (const char* name : {"nearest", "bicubic", "fsr"}) classic.push_back(classic_upscalers().get(name)(scale));
   std::vector<Upscaler*> all;
@@ -219,7 +222,10 @@ ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Data
   if (options.at.size() == 2) {
     corner = {std::min(options.at[0], hr_w - size), std::min(options.at[1], hr_h - size)};
   } else {
-    corner = choose_crop(std::vector<torch::Tensor>(outputs.begin() + 3, outputs.end()), outputs[1], size);
+    // Where the networks' errors differ most from bicubic's (without networks: the other classic
+    // upscalers').
+    std::vector<torch::Tensor> others(outputs.begin() + (networks.empty() ? 0 : 3), outputs.end());
+    corner = choose_crop(others, outputs[1], truth, size);
   }
   ComparisonImage image;
   image.dataset = data.info().name;

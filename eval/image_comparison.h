@@ -28,15 +28,24 @@ struct ComparisonOptions {
   std::vector<int> at;  // [x, y]: the crop's top-left corner in HR pixels; empty = chosen
 };
 config::Schema<ComparisonOptions> comparison_schema_fields();
+// The options of commands that compare no frame unless asked (cgsr eval, cgsr report).
+inline ComparisonOptions no_comparisons() {
+  ComparisonOptions o;
+  o.frames = 0;
+  return o;
+}
 
 // The `count` frames of `result` with the most geometry-edge pixels, most first (ties: the
 // earlier frame); the first `count` frames when it has no edge figures.
 std::vector<int> frames_with_most_edges(const EvalResult& result, int count);
 
-// The top-left corner of the size x size window where `outputs` differ most from `reference`
-// (the summed absolute difference, averaged over the outputs and the colour channels), searched
-// on a grid of size/8 steps; ties go to the first in row order. Tensors are [1, 3, H, W].
-cv::Point choose_crop(const std::vector<torch::Tensor>& outputs, const torch::Tensor& reference, int size);
+// The top-left corner of the size x size window where the errors of `outputs` against `truth`
+// differ most from the error of `reference` (per pixel the absolute error, colour channels
+// averaged; summed over the window and the outputs), searched on a grid of size/8 steps; ties go
+// to the first in row order. Where they differ in error, not merely in pixels: aliasing that
+// every upscaler gets wrong in its own way shows no quality difference. Tensors are [1, 3, H, W].
+cv::Point choose_crop(const std::vector<torch::Tensor>& outputs, const torch::Tensor& reference,
+                      const torch::Tensor& truth, int size);
 
 // One colour scale for the error maps of all `outputs` against `truth`: the 99th percentile of
 // their absolute errors (colour channels averaged) within `region`, at least 1/255.
@@ -56,9 +65,9 @@ struct ComparisonImage {
 nlohmann::ordered_json to_json(const ComparisonImage& image);
 ComparisonImage comparison_from_json(const nlohmann::ordered_json& j, const std::string& context);
 
-// Upscales `frame` of `data` with the classic upscalers (nearest, bicubic, fsr) and `networks`,
-// and writes <dataset>_frame<N>_crops.png and _errors.png into `dir`.
-ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Dataset& data, int frame,
+// Upscales `frame` of `data` by `scale` with the classic upscalers (nearest, bicubic, fsr) and
+// `networks` (may be none), and writes <dataset>_frame<N>_crops.png and _errors.png into `dir`.
+ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Dataset& data, int frame, int scale,
                               const ComparisonOptions& options, const std::filesystem::path& dir);
 
 }  // namespace cgsr

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/metrics.h"
 #include "eval/report.h"
+#include "eval/report_page.h"
 #include "models/model_file.h"
 #include "pruning/hybrid_upscaler.h"
 #include "render_data/dataset.h"
@@ -24,6 +25,9 @@ config::Schema<EvalCommandOptions> eval_schema() {
   s.field("names", &EvalCommandOptions::names, "display names, in the order of models");
   s.field("scale", &EvalCommandOptions::scale, "scale of the classic upscalers").range(2, 4);
   s.section("eval", &EvalCommandOptions::eval, eval_schema_fields(), "what and how to evaluate");
+  s.section("images", &EvalCommandOptions::images, comparison_schema_fields(),
+            "crops and error maps of the evaluated frames with the most geometry edges, into images/");
+  s.omit_when("images", [](const EvalCommandOptions& o) { return o.images.frames == 0; });  // stage hashes as before
   s.validate([](const EvalCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (!o.names.empty() && o.names.size() != o.models.size())
       at.child("names").fail(node["names"] ? node["names"] : node, "needs one name per model");
@@ -53,6 +57,22 @@ Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upsc
     for (auto c : u->channels()) needed.push_back(c);
   if (temporal) needed.push_back(RenderChannel::Motion);
   return open_for_channels(path, needed);
+}
+
+// Comparisons of the `options.frames` frames of `evaluated` with the most geometry edges, with
+// the networks among `upscalers` (the classic ones are always drawn).
+std::vector<ComparisonImage> compare_frames(const std::vector<std::unique_ptr<Upscaler>>& upscalers, const Dataset& data,
+                                            const EvalResult& evaluated, const ComparisonOptions& options,
+                                            const std::filesystem::path& dir) {
+  std::vector<Upscaler*> networks;
+  for (const auto& u : upscalers)
+    if (u->cost(1, 1)) networks.push_back(u.get());  // classic upscalers have no cost and are drawn anyway
+  std::vector<ComparisonImage> out;
+  for (int frame : frames_with_most_edges(evaluated, options.frames)) {
+    spdlog::info("image comparison of {} frame {}", data.info().name, frame);
+    out.push_back(compare_frame(networks, data, frame, upscalers.front()->scale(), options, dir));
+  }
+  return out;
 }
 }  // namespace
 
@@ -106,7 +126,37 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   const auto tables = group_results(results);
   if (run_dir) write_file_atomic(run_dir->file("summary.csv"), report_csv(tables));
   for (const auto& t : tables) std::printf("%s\n", report_markdown(t).c_str());
+  json["comparisons"] = nlohmann::ordered_json::array();
+  if (run_dir && options.images.frames > 0 && !results.empty())
+    for (const auto& c : compare_frames(upscalers, data, results.front(), options.images, run_dir->path() / "images"))
+      json["comparisons"].push_back(to_json(c));
+  if (run_dir) write_report_page(run_dir->path(), json);
   return json;
+}
+
+std::vector<ComparisonImage> compare_eval_run(const std::filesystem::path& run, const ComparisonOptions& options,
+                                              const std::filesystem::path& dir) {
+  const auto config_file = run / "config.yaml";
+  YAML::Node config;
+  try {
+    config = YAML::LoadFile(config_file.string());
+  } catch (const YAML::Exception& e) {
+    throw Error(config_file.string(), std::string("cannot read the run's config: ") + e.what());
+  }
+  if (!config["data"] || !config["models"])
+    throw Error(config_file.string(), "names no data set and models: image comparisons need the run directory of "
+                                      "cgsr eval (in a cgsr run, its eval/ or heldout/<scene>/eval/)");
+  const auto models = config["models"].as<std::vector<std::string>>();
+  const auto names = config["names"] ? config["names"].as<std::vector<std::string>>() : std::vector<std::string>{};
+  const int scale = config["scale"] ? config["scale"].as<int>() : 2;
+  std::vector<std::unique_ptr<Upscaler>> upscalers;
+  for (size_t i = 0; i < models.size(); ++i)
+    if (models[i] != "classic") upscalers.push_back(make_upscaler(models[i], i < names.size() ? names[i] : "", scale));
+  Dataset data = open_for(config["data"].as<std::string>(), upscalers, /*temporal=*/false);
+  if (config["scene"]) data = data.scene(config["scene"].as<std::string>());
+  const auto evaluations = collect_evaluations({run.string()});
+  if (evaluations.empty()) throw Error((run / "results.json").string(), "has no evaluation to show");
+  return compare_frames(upscalers, data, evaluations.front(), options, dir);
 }
 
 }  // namespace cgsr

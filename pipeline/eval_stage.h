@@ -1,7 +1,9 @@
 #pragma once
 // The eval job: what `cgsr eval` runs, and the eval and heldout stages of `cgsr run`. Evaluates
 // model files and classic upscalers on a data set split. Writes results.json (one entry per
-// upscaler), a per-frame CSV per upscaler and summary.csv.
+// upscaler), a per-frame CSV per upscaler, summary.csv, index.html (report_page.h) and, when
+// asked (`images.frames`, `--save-images N`), image comparisons of the frames with the most
+// geometry edges into images/.
 
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -10,6 +12,7 @@
 
 #include "core/run_dir.h"
 #include "eval/evaluation.h"
+#include "eval/image_comparison.h"
 #include "pipeline/run_settings.h"
 
 namespace cgsr {
@@ -21,6 +24,7 @@ struct EvalCommandOptions : RunSettings {
   std::vector<std::string> names;   // display names, in the order of `models` (optional)
   int scale = 2;                    // scale of the classic upscalers (model files carry their own)
   EvalOptions eval;
+  ComparisonOptions images = no_comparisons();   // crops and error maps of that many frames (none by default)
 };
 
 config::Schema<EvalCommandOptions> eval_schema();
@@ -28,5 +32,10 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
 
 // Builds the upscaler for one `models` entry: a model file or a classic upscaler name.
 std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale);
+
+// The image comparisons of an eval run directory after the fact (`cgsr report --frames`): its
+// config.yaml names the data set and the models, its results.json the frames evaluated.
+std::vector<ComparisonImage> compare_eval_run(const std::filesystem::path& run, const ComparisonOptions& options,
+                                              const std::filesystem::path& dir);
 
 }  // namespace cgsr

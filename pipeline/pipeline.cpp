@@ -651,10 +651,10 @@ class Pipeline {
     for (size_t i = 0; i < own.size(); ++i)
       if (!classic_upscalers().contains(own[i].name)) networks.push_back(upscalers[i].get());
     const EvalResult* bicubic = find_result(own, "bicubic");
-    if (!bicubic || networks.empty()) return out;
+    if (!bicubic) return out;
     for (int frame : frames_with_most_edges(*bicubic, options_.images.frames)) {
       spdlog::info("report: image comparison of {} frame {}", data_->info().name, frame);
-      out.push_back(compare_frame(networks, *data_, frame, options_.images, dir));
+      out.push_back(compare_frame(networks, *data_, frame, backbone_.scale, options_.images, dir));
     }
     const auto scenes = heldout_scenes(heldout_.summary);
     for (size_t k = 0; k < scenes.size(); ++k) {
@@ -664,7 +664,7 @@ class Pipeline {
       const Dataset level = Dataset::open(heldout_.summary.at("scenes").at(k).at("data").get<std::string>());
       for (int frame : frames_with_most_edges(*row, 1)) {
         spdlog::info("report: image comparison of {} frame {}", scenes[k], frame);
-        out.push_back(compare_frame(networks, level, frame, options_.images, dir));
+        out.push_back(compare_frame(networks, level, frame, backbone_.scale, options_.images, dir));
       }
     }
     return out;

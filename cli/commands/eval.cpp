@@ -17,6 +17,8 @@ void setup_eval(CLI::App& app) {
         flag_to_key(sub, flags, "--scale", "scale", "scale of the classic upscalers");
         flag_to_key(sub, flags, "--crop-border", "eval.crop_border", "HR pixels ignored at each border");
         flag_to_key(sub, flags, "--save-frames", "eval.save_frames", "directory for upscaled frames");
+        flag_to_key(sub, flags, "--save-images", "images.frames",
+                    "crops and error maps of the N frames with the most geometry edges, into images/");
         flag_to_key(sub, flags, "--frames", "eval.frames", "frame index range A:B within the split");
         flag_to_key(sub, flags, "--latency-runs", "eval.latency_runs", "timed runs for latency (0 = skip)");
       },

@@ -1,7 +1,8 @@
 #pragma once
-// `cgsr report RUN_DIRS... --out DIR`: collects the evaluations of run directories (results.json
-// of `cgsr eval` or `cgsr run`) into report.md, report.csv and one PSNR-against-latency plot per
-// scene and scale.
+// `cgsr report RUN_DIRS... --out DIR [--frames N]`: collects the evaluations of run directories
+// (results.json of `cgsr eval` or `cgsr run`) into report.md, report.csv, index.html and one
+// PSNR-against-latency plot per scene and scale; with --frames, image comparisons of the N
+// frames with the most geometry edges of each eval run directory.
 
 #include <CLI/CLI.hpp>
 
@@ -12,6 +13,7 @@ namespace cgsr::cli {
 
 struct ReportOptions : RunSettings {
   std::vector<std::string> runs;  // run directories or results.json files (required)
+  ComparisonOptions images = no_comparisons();  // image comparisons per eval run directory (none by default)
 };
 
 config::Schema<ReportOptions> report_schema();
