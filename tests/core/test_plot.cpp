@@ -1,8 +1,11 @@
-// Bar charts: a category's name gets the room it needs under the axis (the ablation's variant
-// names run to 35 characters), and a series that does not match the categories is an error.
+// Plots: a bar chart's category name gets the room it needs under the axis (the ablation's
+// variant names run to 35 characters), a series that does not match the categories is an error,
+// and no text of a plot overlaps another or leaves the canvas (the label test).
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <tuple>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
@@ -41,4 +44,77 @@ TEST(BarChart, ASeriesMustHaveOneValuePerCategory) {
   BarChart c = chart("hr_fuse");
   c.series[0].values.pop_back();
   EXPECT_THROW(write_bar_chart(fs::temp_directory_path() / "cgsr-test-plot-bad.png", c), Error);
+}
+
+namespace {
+// Every text inside the canvas and clear of every other text.
+void expect_readable(const Canvas& canvas, const std::string& what) {
+  const auto& boxes = canvas.text_boxes();
+  ASSERT_FALSE(boxes.empty()) << what;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    EXPECT_TRUE(boxes[i].inside(canvas.bounds())) << what << ": text " << i << " leaves the canvas";
+    for (size_t j = i + 1; j < boxes.size(); ++j)
+      EXPECT_FALSE(boxes[i].overlaps(boxes[j])) << what << ": texts " << i << " and " << j << " overlap";
+  }
+}
+}  // namespace
+
+// The quickstart's crowded corner: nine networks within 0.5 dB and a factor 3 of latency, two
+// pairs of them on the same spot, plus frames that chose the same pattern at the same density.
+TEST(ScatterPlot, LabelsNeverOverlapOrLeaveTheCanvas) {
+  ScatterPlot plot;
+  plot.title = "varied_indoor x2: PSNR against latency";
+  plot.x_label = "latency (ms, median, log scale)";
+  plot.y_label = "PSNR (dB)";
+  plot.log_x = true;
+  PlotSeries networks{"network", {40, 90, 180}, 5, false, Marker::Circle, true, {}};
+  const std::vector<std::tuple<double, double, std::string>> rows = {
+      {374.3, 25.43, "PAN x2"}, {374.4, 25.46, "PAN x2 (control)"}, {394.2, 25.49, "CG-enhanced PAN x2"},
+      {390.5, 25.48, "elastic CG-enhanced PAN x2"}, {122.9, 25.55, "CG-optimized PAN x2 (scratch)"},
+      {127.2, 25.15, "CG-enhanced PAN x2 MMP"}, {128.9, 25.43, "CG-enhanced PAN x2 uniform width"},
+      {121.8, 25.44, "CG-optimized PAN x2"}, {242.6, 25.45, "CG-optimized PAN x2 static"},
+      {182.5, 25.26, "CG-optimized PAN x2 hybrid"}, {2.84, 24.40, "bicubic"}, {0.63, 23.77, "bilinear"},
+      {121.8, 25.44, "the same spot"}, {121.8, 25.44, "and once more"}};
+  for (const auto& [x, y, name] : rows) networks.points.push_back({x, y, name});
+  plot.series = {networks};
+  plot.links = {{394.2, 25.49, 374.4, 25.46}};
+  plot.links_name = "a network and its control";
+  plot.horizontal_lines = {{25.0, "fsr (no latency)"}};
+  const auto canvas = draw_scatter_plot(plot);
+  expect_readable(*canvas, "report plot");
+
+  ScatterPlot choices;
+  choices.title = "CG-optimized PAN x2 hybrid: pattern chosen per frame";
+  choices.x_label = "geometry-edge pixels of the frame (%)";
+  choices.y_label = "channels the chosen pattern keeps (%)";
+  PlotSeries frames{"pattern 0 (40 frames)", {220, 40, 40}, 5, false, Marker::Circle, true, {}};
+  for (int f = 0; f < 40; ++f) frames.points.push_back({7.0 + 0.01 * (f % 5), 100.0, std::to_string(f)});
+  choices.series = {frames};
+  expect_readable(*draw_scatter_plot(choices), "pattern choice plot");
+}
+
+TEST(BarChart, LabelsNeverOverlapOrLeaveTheCanvas) {
+  BarChart c = chart("hr_unshuffle+hr_fuse - normal_angle (a long variant name)");
+  c.title = "a title longer than the chart's few bars would make room for";
+  expect_readable(*draw_bar_chart(c), "bar chart");
+}
+
+TEST(Canvas, SavesPngSvgAndPdfByExtension) {
+  const fs::path dir = fs::temp_directory_path() / "cgsr-test-canvas";
+  Canvas c(120, 80);
+  c.text({10, 40}, "PSNR 25.4 dB", {});
+  c.marker({100, 40}, Marker::Diamond, 5, {220, 40, 40}, true);
+  c.save(dir / "c.png");
+  c.save(dir / "c.svg");
+  c.save(dir / "c.pdf");
+  const cv::Mat png = cv::imread((dir / "c.png").string());
+  EXPECT_EQ(png.cols, 120);
+  EXPECT_EQ(png.rows, 80);
+  EXPECT_LT(cv::mean(png)[0], 254.0);  // something was drawn on the white
+  std::ifstream svg(dir / "c.svg"), pdf(dir / "c.pdf");
+  const std::string svg_text((std::istreambuf_iterator<char>(svg)), {}), pdf_text((std::istreambuf_iterator<char>(pdf)), {});
+  EXPECT_NE(svg_text.find("<svg"), std::string::npos);
+  EXPECT_EQ(pdf_text.substr(0, 5), "%PDF-");
+  EXPECT_THROW(c.save(dir / "c.jpg"), Error);
+  fs::remove_all(dir);
 }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/cli_runner.h"
+#include "tests/support/page_links.h"
 
 using namespace cgsr::test;
 namespace fs = std::filesystem;
@@ -151,6 +152,15 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   for (const std::string row : {"bicubic", "nearest", "PAN x2", "PAN x2 (control)", "CG-enhanced PAN x2", "CG-optimized PAN x2",
                                 "CG-optimized PAN x2 (scratch)", "CG-enhanced PAN x2 MMP", "CG-optimized PAN x2 hybrid"})
     EXPECT_NE(report.find("| " + row + " ", section), std::string::npos) << row << "\n" << report;
+  // The page: the verdict's checks, and pictures of the test frames and of the held-out scene.
+  const auto page = out / "report" / "index.html";
+  const std::string html = slurp(page);
+  EXPECT_NE(html.find("Verdict:"), std::string::npos);
+  EXPECT_NE(html.find("plot_tiny_x2.svg"), std::string::npos);
+  EXPECT_TRUE(missing_links(page).empty()) << missing_links(page).front();
+  const auto comparisons = read_json(out / "report" / "results.json")["comparisons"];
+  ASSERT_GE(comparisons.size(), 2u);
+  EXPECT_EQ(comparisons.back()["dataset"], "tiny-heldout");
   int heldout_checks = 0;
   for (const auto& check : results["verdict"]["checks"])
     heldout_checks += check["claim"].get<std::string>().find("on held-out scene 'tiny-heldout'") != std::string::npos;
