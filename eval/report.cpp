@@ -26,20 +26,48 @@ std::string csv_field(const std::string& text) {
 std::string optional_fixed(std::optional<double> v, int digits, const std::string& none) {
   return v ? fixed(*v, digits) : none;
 }
+
+// Which optional columns a table prints.
+struct Shown {
+  bool latency, onnxruntime, edges;
+};
+Shown shown(const ReportTable& table) {
+  const auto any = [&](auto has) { return std::any_of(table.rows.begin(), table.rows.end(), has); };
+  return {any([](const EvalResult& r) { return r.latency.has_value(); }),
+          any([](const EvalResult& r) { return r.onnxruntime_latency.has_value(); }),
+          any([](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; })};
+}
 }  // namespace
 
-ReportCells report_cells(const EvalResult& r) {
-  ReportCells c;
-  c.params = r.cost ? fixed(r.cost->params / 1000.0, 1) : "NA";
-  c.macs = r.cost ? fixed(r.cost->macs / 1e9, 2) : "NA";
-  c.latency = r.latency ? fixed(r.latency->median_ms, 2) : "-";
-  c.ort_latency = r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 2) : "-";
-  c.psnr = fixed(r.psnr, 2);
-  c.psnr_edge = optional_fixed(r.psnr_edge, 2, "-");
-  c.psnr_rest = optional_fixed(r.psnr_rest, 2, "-");
-  c.ssim = fixed(r.ssim, 4);
-  c.temporal = r.temporal_error ? fixed(*r.temporal_error * 1000.0, 2) : "-";
-  return c;
+std::vector<std::string> report_columns(const ReportTable& table) {
+  const Shown s = shown(table);
+  std::vector<std::string> columns = {"Params (k)", "MACs (G)"};
+  if (s.latency) columns.push_back("Latency (ms)");
+  if (s.onnxruntime) columns.push_back("ONNX Runtime (ms)");
+  columns.push_back("PSNR (dB)");
+  if (s.edges) columns.insert(columns.end(), {"Edge PSNR (dB)", "Rest PSNR (dB)"});
+  columns.insert(columns.end(), {"SSIM", "Temporal error (x1e-3)"});
+  return columns;
+}
+
+std::vector<ReportCell> report_row(const EvalResult& r, const ReportTable& table) {
+  const Shown s = shown(table);
+  const auto ms = [](const std::optional<LatencyStats>& l) {
+    return l ? ReportCell{fixed(l->median_ms, 2), l->median_ms} : ReportCell{"-", std::nullopt};
+  };
+  const auto optional = [](std::optional<double> v, double factor, int digits) {
+    return v ? ReportCell{fixed(*v * factor, digits), *v} : ReportCell{"-", std::nullopt};
+  };
+  std::vector<ReportCell> row;
+  row.push_back(r.cost ? ReportCell{fixed(r.cost->params / 1000.0, 1), double(r.cost->params)} : ReportCell{"NA", {}});
+  row.push_back(r.cost ? ReportCell{fixed(r.cost->macs / 1e9, 2), double(r.cost->macs)} : ReportCell{"NA", {}});
+  if (s.latency) row.push_back(ms(r.latency));
+  if (s.onnxruntime) row.push_back(ms(r.onnxruntime_latency));
+  row.push_back({fixed(r.psnr, 2), r.psnr});
+  if (s.edges) row.insert(row.end(), {optional(r.psnr_edge, 1, 2), optional(r.psnr_rest, 1, 2)});
+  row.push_back({fixed(r.ssim, 4), r.ssim});
+  row.push_back(optional(r.temporal_error, 1000.0, 2));
+  return row;
 }
 
 std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
@@ -75,27 +103,25 @@ std::string report_markdown(const ReportTable& table) {
   const auto& first = table.rows.front();
   md << "### " << table.dataset << " x" << table.scale << " (" << first.split << " split, " << first.frames.size()
      << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
-  const bool ort = std::any_of(table.rows.begin(), table.rows.end(),
-                               [](const EvalResult& r) { return r.onnxruntime_latency.has_value(); });
-  // Edge and rest PSNR need the dataset's edge channel; rows from older results lack them.
-  const auto with_edges = std::find_if(table.rows.begin(), table.rows.end(),
-                                       [](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
-  const bool edges = with_edges != table.rows.end();
-  // A table evaluated for quality only (latency_runs 0, a held-out scene) has no latency column.
-  const bool timed = std::any_of(table.rows.begin(), table.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); });
-  md << "| Model | Params (k) | MACs (G) |" << (timed ? " Latency (ms) |" : "") << (ort ? " ONNX Runtime (ms) |" : "")
-     << " PSNR (dB) |" << (edges ? " Edge PSNR (dB) | Rest PSNR (dB) |" : "") << " SSIM | Temporal error (x1e-3) |\n";
-  md << "|---|---:|---:|" << (timed ? "---:|" : "") << (ort ? "---:|" : "") << "---:|" << (edges ? "---:|---:|" : "")
-     << "---:|---:|\n";
+  const auto columns = report_columns(table);
+  md << "| Model |";
+  for (const auto& c : columns) md << " " << c << " |";
+  md << "\n|---|";
+  for (size_t i = 0; i < columns.size(); ++i) md << "---:|";
+  md << "\n";
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
-    const auto c = report_cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-    md << "| " << r.name << (on_front ? " *" : "") << " | " << c.params << " | " << c.macs << " | "
-       << (timed ? c.latency + " | " : "") << (ort ? c.ort_latency + " | " : "") << c.psnr << " | "
-       << (edges ? c.psnr_edge + " | " + c.psnr_rest + " | " : "") << c.ssim << " | " << c.temporal << " |\n";
+    md << "| " << r.name << (on_front ? " *" : "") << " |";
+    for (const auto& cell : report_row(r, table)) md << " " << cell.text << " |";
+    md << "\n";
   }
+  const Shown s = shown(table);
+  const bool timed = s.latency, ort = s.onnxruntime, edges = s.edges;
+  // Edge and rest PSNR need the dataset's edge channel; rows from older results lack them.
+  const auto with_edges = std::find_if(table.rows.begin(), table.rows.end(),
+                                       [](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
   if (first.temporal_error_reference)
     md << "\nTemporal error of the ground truth (the floor): " << fixed(*first.temporal_error_reference * 1000.0, 2)
        << "e-3. ";

@@ -30,11 +30,17 @@ struct ReportTable {
 // Groups results by (dataset, scale), keeping their order within each group.
 std::vector<ReportTable> group_results(const std::vector<EvalResult>& results);
 
-// A row's figures as the tables print them ("-" or "NA" where there is none).
-struct ReportCells {
-  std::string params, macs, latency, ort_latency, psnr, psnr_edge, psnr_rest, ssim, temporal;
+// The columns of a table after the model's name: latency only when some row was timed, ONNX
+// Runtime only when some row has it, edge and rest PSNR only when some row has them.
+std::vector<std::string> report_columns(const ReportTable& table);
+
+// A row's figures in those columns, as printed ("-" or "NA" where there is none), with the value
+// behind each for sorting (none where there is none).
+struct ReportCell {
+  std::string text;
+  std::optional<double> value;
 };
-ReportCells report_cells(const EvalResult& r);
+std::vector<ReportCell> report_row(const EvalResult& r, const ReportTable& table);
 
 std::string report_markdown(const ReportTable& table);
 std::string report_csv(const std::vector<ReportTable>& tables);

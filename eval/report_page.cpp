@@ -63,41 +63,28 @@ document.querySelectorAll('table.sortable').forEach(function (table) {
 });
 )";
 
-// A numeric cell: its text, and its value for sorting when it has one.
-std::string number_cell(const std::string& text, std::optional<double> value) {
-  return std::string("<td class=\"n\"") + (value ? " data-v=\"" + fixed(*value, 6) + "\"" : " data-v=\"-1e300\"") + ">" +
-         html_escape(text) + "</td>";
+// A numeric cell: its text, and its value for sorting (cells without one sort first).
+std::string number_cell(const ReportCell& cell) {
+  return "<td class=\"n\" data-v=\"" + (cell.value ? fixed(*cell.value, 6) : std::string("-1e300")) + "\">" +
+         html_escape(cell.text) + "</td>";
 }
 
 std::string table_html(const ReportTable& table) {
-  const auto has = [&](auto pred) { return std::any_of(table.rows.begin(), table.rows.end(), pred); };
-  const bool timed = has([](const EvalResult& r) { return r.latency.has_value(); });
-  const bool ort = has([](const EvalResult& r) { return r.onnxruntime_latency.has_value(); });
-  const bool edges = has([](const EvalResult& r) { return r.psnr_edge || r.psnr_rest; });
   std::ostringstream h;
-  h << "<table class=\"sortable\"><thead><tr><th>Model</th><th>Params (k)</th><th>MACs (G)</th>"
-    << (timed ? "<th>Latency (ms)</th>" : "") << (ort ? "<th>ONNX Runtime (ms)</th>" : "") << "<th>PSNR (dB)</th>"
-    << (edges ? "<th>Edge PSNR (dB)</th><th>Rest PSNR (dB)</th>" : "")
-    << "<th>SSIM</th><th>Temporal error (x1e-3)</th></tr></thead><tbody>\n";
+  h << "<table class=\"sortable\"><thead><tr><th>Model</th>";
+  for (const auto& c : report_columns(table)) h << "<th>" << html_escape(c) << "</th>";
+  h << "</tr></thead><tbody>\n";
   const auto front = pareto_front(table);
   for (size_t i = 0; i < table.rows.size(); ++i) {
     const auto& r = table.rows[i];
-    const auto c = report_cells(r);
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-    const auto ms = [](const std::optional<LatencyStats>& l) {
-      return l ? std::optional<double>(l->median_ms) : std::nullopt;
-    };
     h << "<tr" << (on_front ? " class=\"front\"" : "") << "><td>" << html_escape(r.name) << (on_front ? " *" : "")
-      << "</td>" << number_cell(c.params, r.cost ? std::optional<double>(r.cost->params) : std::nullopt)
-      << number_cell(c.macs, r.cost ? std::optional<double>(r.cost->macs) : std::nullopt);
-    if (timed) h << number_cell(c.latency, ms(r.latency));
-    if (ort) h << number_cell(c.ort_latency, ms(r.onnxruntime_latency));
-    h << number_cell(c.psnr, r.psnr);
-    if (edges) h << number_cell(c.psnr_edge, r.psnr_edge) << number_cell(c.psnr_rest, r.psnr_rest);
-    h << number_cell(c.ssim, r.ssim) << number_cell(c.temporal, r.temporal_error) << "</tr>\n";
+      << "</td>";
+    for (const auto& cell : report_row(r, table)) h << number_cell(cell);
+    h << "</tr>\n";
   }
   h << "</tbody></table>\n";
-  if (timed)
+  if (!front.empty())
     h << "<p class=\"note\">* on the Pareto front of PSNR against latency (bold). Click a column's title to sort. "
          "MACs at the evaluated LR size; latency is the median of repeated runs on this machine.</p>\n";
   return h.str();
@@ -140,12 +127,12 @@ std::string pattern_choice_html(const std::string& model, const PatternChoices& 
   h << "<table class=\"sortable\"><thead><tr><th>Frame</th><th>Edge pixels (%)</th><th>Pattern</th>"
        "<th>Channels kept (%)</th><th>PSNR (dB)</th></tr></thead><tbody>\n";
   for (const auto& c : choices.frames)
-    h << "<tr>" << number_cell(std::to_string(c.frame), c.frame)
-      << number_cell(c.edge_fraction ? fixed(100.0 * *c.edge_fraction, 2) : "-",
-                     c.edge_fraction ? std::optional<double>(*c.edge_fraction) : std::nullopt)
-      << number_cell(std::to_string(c.pattern), c.pattern)
-      << number_cell(fixed(100.0 * c.channel_fraction, 0), c.channel_fraction) << number_cell(fixed(c.psnr, 2), c.psnr)
-      << "</tr>\n";
+    h << "<tr>" << number_cell({std::to_string(c.frame), c.frame})
+      << number_cell(c.edge_fraction ? ReportCell{fixed(100.0 * *c.edge_fraction, 2), *c.edge_fraction}
+                                     : ReportCell{"-", std::nullopt})
+      << number_cell({std::to_string(c.pattern), c.pattern})
+      << number_cell({fixed(100.0 * c.channel_fraction, 0), c.channel_fraction})
+      << number_cell({fixed(c.psnr, 2), c.psnr}) << "</tr>\n";
   h << "</tbody></table>\n";
   return h.str();
 }
