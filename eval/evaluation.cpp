@@ -140,7 +140,12 @@ std::optional<double> mean_of(const std::vector<FrameScore>& frames, std::option
 }  // namespace
 
 torch::Tensor TimingSequence::run(Upscaler& upscaler, size_t i) const {
-  if (!previous.empty()) upscaler.previous_frame(previous.at(i));
+  if (!previous.empty()) {
+    if (previous.at(i).lr_color.defined())
+      upscaler.previous_frame(previous.at(i));
+    else
+      upscaler.reset_history();
+  }
   return upscaler.upscale(frames.at(i));
 }
 
@@ -155,7 +160,7 @@ TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& fram
   for (int f : spread_frames(frames, std::min(kMaxFrames, std::max(1, count)))) {
     out.frames.push_back(frame_batch(data, f, scale, channels, depth));
     if (upscaler.uses_previous_frame())
-      out.previous.push_back(frame_batch(data, data.has_previous(f) ? f - 1 : f, scale, channels, depth));
+      out.previous.push_back(data.has_previous(f) ? frame_batch(data, f - 1, scale, channels, depth) : Batch{});
   }
   return out;
 }
@@ -185,8 +190,12 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   int psnr_count = 0;
   // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
   const auto upscale_frame = [&](const Batch& b, int frame) {
-    if (upscaler.uses_previous_frame() && data.has_previous(frame))
-      upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));
+    if (upscaler.uses_previous_frame()) {
+      if (data.has_previous(frame))
+        upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));
+      else
+        upscaler.reset_history();
+    }
     return upscaler.upscale(b);
   };
   // The last evaluated frame and its output: consecutive frames (a range) reuse it as the

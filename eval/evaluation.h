@@ -72,7 +72,9 @@ struct EvalResult {
 // first, as evaluate() does, so that it is timed on the choices it was evaluated with.
 struct TimingSequence {
   std::vector<Batch> frames;
-  std::vector<Batch> previous;  // previous[i]: the frame before frames[i]; empty when not read
+  // previous[i]: the frame before frames[i], an empty Batch when it has none (the upscaler's
+  // history is then reset); no entries when the upscaler reads no previous frame.
+  std::vector<Batch> previous;
 
   size_t size() const { return frames.size(); }
   // Upscales frame i (after showing the upscaler its predecessor).

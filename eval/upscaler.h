@@ -48,6 +48,9 @@ class Upscaler {
   // channels(), to previous_frame() before upscale() of the frame after it.
   virtual bool uses_previous_frame() const { return false; }
   virtual void previous_frame(const Batch& previous) {}
+  // The next frame has no predecessor (a sequence's first frame, or a scene cut in a multi-scene
+  // data set): forget every frame seen so far.
+  virtual void reset_history() {}
   // The pattern the last upscale() chose, for the per-frame record; none for upscalers that
   // choose nothing.
   virtual std::optional<PatternChoice> frame_choice() const { return std::nullopt; }

@@ -30,6 +30,11 @@ void HybridUpscaler::previous_frame(const Batch& previous) {
   previous_frame_ = previous.frames.empty() ? -1 : previous.frames.front();
 }
 
+void HybridUpscaler::reset_history() {
+  previous_info_ = last_info_ = torch::Tensor();
+  previous_frame_ = last_frame_ = -1;
+}
+
 int HybridUpscaler::choose(const Batch& batch) {
   if (batch.lr_color.size(0) != 1)
     throw Error("hybrid-pruned model", "chooses patterns per frame: give one frame at a time, got a batch of " +

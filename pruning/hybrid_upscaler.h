@@ -7,7 +7,8 @@
 //
 // The previous frame is the one given to previous_frame(), else the frame of the last
 // upscale() call when it is the frame just before (a renderer calling it frame after frame),
-// else none (its change is taken as zero).
+// else none (its change is taken as zero). reset_history() forgets both: a scene cut, where the
+// frame index goes on but the content does not.
 
 #include <chrono>
 #include <memory>
@@ -32,6 +33,7 @@ class HybridUpscaler : public Upscaler {
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   bool uses_previous_frame() const override { return true; }
   void previous_frame(const Batch& previous) override;
+  void reset_history() override;
   std::optional<PatternChoice> frame_choice() const override { return choice_; }
 
   // The pattern chosen for a frame from its rendering information.

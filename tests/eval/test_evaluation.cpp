@@ -293,3 +293,52 @@ TEST(Evaluation, TimingShowsEachFrameItsPredecessor) {
   const std::vector<int> timing(recording.seen.end() - 10, recording.seen.end());
   EXPECT_EQ(timing, (std::vector<int>{-2, 3, -3, 4, -2, 3, -3, 4, -2, 3}));
 }
+
+namespace {
+// A nearest-neighbour upscaler that reads the previous frame and records what it was shown.
+class HistoryRecorder : public Upscaler {
+ public:
+  std::string name() const override { return "recorder"; }
+  int scale() const override { return 2; }
+  bool uses_previous_frame() const override { return true; }
+  void previous_frame(const Batch& previous) override { shown_.push_back("previous " + std::to_string(previous.frames.at(0))); }
+  void reset_history() override { shown_.push_back("reset"); }
+  torch::Tensor upscale(const Batch& batch) override {
+    shown_.push_back("frame " + std::to_string(batch.frames.at(0)));
+    return torch::nn::functional::interpolate(
+        batch.lr_color, torch::nn::functional::InterpolateFuncOptions().scale_factor(std::vector<double>{2, 2}).mode(torch::kNearest));
+  }
+  std::vector<std::string> shown_;
+};
+}  // namespace
+
+// A multi-scene data set numbers its frames on across scenes: the first frame of the second
+// scene must not see the last frame of the first as its predecessor. Evaluation and timing reset
+// the upscaler's history there instead.
+TEST(Evaluation, HistoryIsResetAtEverySceneCut) {
+  const auto dir = scratch_dir("eval-scene-cut");
+  std::string second = slurp(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
+  second.replace(second.find("name: tiny\n"), 11, "name: tiny_b\n");
+  std::ofstream(dir / "tiny_b.yaml") << second;
+  const auto render = run_cgsr("render --scene " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --scene " +
+                               (dir / "tiny_b.yaml").string() + " --out " + (dir / "set").string() + " --threads 1");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const Dataset data = Dataset::open(dir / "set");
+  ASSERT_EQ(data.scenes().size(), 2u);
+  const int cut = data.frames(Split::All).size() / 2;  // both scenes have 6 frames
+  ASSERT_FALSE(data.has_previous(cut));
+
+  HistoryRecorder recorder;
+  EvalOptions options = all_frames(std::to_string(cut - 1) + ":" + std::to_string(cut + 2));
+  options.temporal = false;
+  evaluate(recorder, data, options);
+  const std::vector<std::string> expected = {"previous " + std::to_string(cut - 2), "frame " + std::to_string(cut - 1),
+                                             "reset",  "frame " + std::to_string(cut),
+                                             "previous " + std::to_string(cut), "frame " + std::to_string(cut + 1)};
+  EXPECT_EQ(recorder.shown_, expected);
+
+  recorder.shown_.clear();
+  const TimingSequence timing = timing_sequence(data, {cut}, 2, recorder, 1);
+  timing.run(recorder, 0);
+  EXPECT_EQ(recorder.shown_, (std::vector<std::string>{"reset", "frame " + std::to_string(cut)}));
+}
