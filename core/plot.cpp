@@ -9,7 +9,8 @@
 namespace cgsr {
 namespace {
 const TextStyle kTitle{16, true}, kAxis{13}, kTick{11, false, {70, 70, 70}}, kLabel{11}, kLegend{12};
-const Rgb kBlack{0, 0, 0}, kGrid{225, 225, 225}, kFrame{60, 60, 60}, kLeader{150, 150, 150};
+constexpr double kLabelGap = 4;  // pixels between a point label and any other text or marker
+const Rgb kBlack{0, 0, 0}, kGrid{225, 225, 225}, kFrame{60, 60, 60}, kLeader{150, 150, 150}, kLink{70, 70, 70};
 
 std::string tick_text(double v) {
   std::ostringstream s;
@@ -60,7 +61,7 @@ void tick_label(Canvas& canvas, Point2 at, const std::string& text, Anchor ancho
 // Where a label of `size` may go around a marker of radius `r` at `p`: first right next to it
 // (east, west, the diagonals, north, south), then on rings further out, joined by a leader line.
 std::vector<Box> label_candidates(Point2 p, double r, const Box& size) {
-  const double w = size.width(), h = size.height(), d = r * 1.3 + 4;  // clear of the marker's box
+  const double w = size.width(), h = size.height(), d = r * 1.3 + 2 + kLabelGap;  // clear of the marker's box
   std::vector<Box> out = {
       {p.x + d, p.y - h / 2, p.x + d + w, p.y + h / 2},          {p.x - d - w, p.y - h / 2, p.x - d, p.y + h / 2},
       {p.x + d * 0.7, p.y - d * 0.7 - h, p.x + d * 0.7 + w, p.y - d * 0.7},
@@ -144,7 +145,7 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
     const Box size = probe.measure(text, kLabel);
     const auto candidates = label_candidates(at, radius, size);
     for (size_t c = 0; c < candidates.size(); ++c)
-      if (candidates[c].inside(inner) && !collides(candidates[c].grown(1.5), taken)) {
+      if (candidates[c].inside(inner) && !collides(candidates[c].grown(kLabelGap), taken)) {
         taken.push_back(candidates[c]);
         placed.push_back({text, at, candidates[c], c >= 8});
         return true;
@@ -193,7 +194,6 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
     c.line({lx, ly}, {lx + 22, ly}, {120, 120, 120}, 1, true);
     legend_text(text);
   }
-  for (const auto& link : plot.links) c.line({px(link.x0), py(link.y0)}, {px(link.x1), py(link.y1)}, {150, 150, 150}, 1.2, true);
   for (const auto& s : plot.series) {
     if (s.connect && s.points.size() > 1) {
       auto sorted = s.points;
@@ -209,12 +209,14 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
     legend_text(s.name);
   }
   if (!plot.links.empty() && !plot.links_name.empty()) {
-    c.line({lx, ly}, {lx + 22, ly}, {150, 150, 150}, 1.2, true);
+    c.line({lx, ly}, {lx + 22, ly}, kLink, 1.6, true);
     legend_text(plot.links_name);
   }
   for (const auto& note : plot.notes) legend_text(note);
   for (const auto& n : numbered) legend_text(n);
 
+  // Links over the series' lines (a pair often lies along the Pareto front), under the markers.
+  for (const auto& link : plot.links) c.line({px(link.x0), py(link.y0)}, {px(link.x1), py(link.y1)}, kLink, 1.6, true);
   for (const auto& s : plot.series)
     for (const auto& p : s.points)
       if (!(plot.log_x && p.x <= 0)) c.marker({px(p.x), py(p.y)}, s.marker, s.radius, s.colour, s.filled);
