@@ -31,8 +31,12 @@ void commit(const fs::path& temporary, const fs::path& path) {
   std::error_code ec;
   fs::rename(temporary, path, ec);
   if (ec) {
-    fs::remove(temporary, ec);
-    throw Error(path.string(), "cannot move the finished file into place: " + ec.message());
+    // The message is taken before the clean-up, whose own error code would overwrite it.
+    std::string why = ec.message();
+    if (fs::is_directory(path)) why = "a directory of that name is in the way (remove it or choose another name)";
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw Error(path.string(), "cannot move the finished file into place: " + why);
   }
 }
 }  // namespace

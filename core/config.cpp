@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -66,6 +68,8 @@ void Document::apply_override(const std::string& assignment, const std::string& 
     if (!next || next.IsNull()) {
       chain.back()[keys[i]] = YAML::Node(YAML::NodeType::Map);
       next = chain.back()[keys[i]];
+      // A map made for the path has no file position: errors about it name the assignment.
+      data_->overrides.emplace_back(next, where);
     } else if (!next.IsMap()) {
       throw Error(where, "'" + keys[i] + "' is not a map, so it has no key '" + keys[i + 1] + "'");
     }
@@ -73,6 +77,23 @@ void Document::apply_override(const std::string& assignment, const std::string& 
   }
   chain.back()[keys.back()] = value;
   data_->overrides.emplace_back(chain.back()[keys.back()], where);
+  // Every node inside the value too: an error about a list element or an inner key names the
+  // assignment, not the config file's position of the same line and column.
+  std::function<void(const YAML::Node&)> record_inner = [&](const YAML::Node& node) {
+    if (node.IsSequence()) {
+      for (const auto& item : node) {
+        data_->overrides.emplace_back(item, where);
+        record_inner(item);
+      }
+    } else if (node.IsMap()) {
+      for (const auto& kv : node) {
+        data_->overrides.emplace_back(kv.first, where);
+        data_->overrides.emplace_back(kv.second, where);
+        record_inner(kv.second);
+      }
+    }
+  };
+  record_inner(value);
 }
 
 const YAML::Node& Document::root() const { return data_->root; }
@@ -104,6 +125,37 @@ std::string describe(const YAML::Node& node) {
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a map";
   return "'" + node.Scalar() + "'";
+}
+
+std::string number(double x) {
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  std::ostringstream out;
+  out.precision(12);
+  out << x;
+  return out.str();
+}
+
+namespace {
+std::string range_text(double lo, double hi) {
+  return "[" + number(lo) + ", " + number(hi) + (std::isinf(hi) ? ")" : "]");
+}
+}  // namespace
+
+void require_in_range(double v, double lo, double hi, const YAML::Node& node, const Cursor& at) {
+  if (v >= lo && v <= hi) return;
+  const std::string written = node.IsScalar() ? describe(node) : number(v);
+  at.fail(node, written + " is out of range " + range_text(lo, hi));
+}
+
+void check_range(const YAML::Node& node, double lo, double hi, const Cursor& at) {
+  if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) check_range(node[i], lo, hi, at.index(i));
+    return;
+  }
+  double x = 0;
+  // Not a finite number: the field's decoder says what was expected.
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, x) || !std::isfinite(x)) return;
+  require_in_range(x, lo, hi, node, at);
 }
 
 YAML::Node lift_moved_blocks(const YAML::Node& map, const std::vector<std::string>& moved, const Cursor& at) {

@@ -93,7 +93,9 @@ std::vector<fs::path> glob_files(const fs::path& base, const std::string& patter
   const fs::path full = base / pattern;
   const fs::path dir = full.parent_path();
   const std::string name = full.filename().string();
-  if (dir.string().find_first_of("*?") != std::string::npos)
+  // Only the pattern's own folders are read as wildcards: the capture's folder may be named
+  // anything, '*' included.
+  if (fs::path(pattern).parent_path().string().find_first_of("*?") != std::string::npos)
     throw Error(pattern, "wildcards are only supported in the file name, not in folders");
   if (!fs::is_directory(dir)) throw Error(pattern, "no such folder " + dir.string());
   std::vector<fs::path> out;
@@ -260,7 +262,9 @@ bool looks_like_glob_layout(const fs::path& path) {
     const YAML::Node n = YAML::LoadFile(yaml.string());
     return n.IsMap() && n["layout"] && n["layout"].IsScalar() && n["layout"].Scalar() == "glob";
   } catch (const YAML::Exception&) {
-    return false;
+    // A YAML file that does not parse can only be meant as a capture: opening it reports the
+    // syntax error with its line and column, not "not a dataset".
+    return true;
   }
 }
 

@@ -49,3 +49,21 @@ TEST(AtomicFile, MissingFileNamesIt) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/cgsr/file.txt"), std::string::npos);
   }
 }
+
+// Renaming over a directory fails; the message once read "Success" (the clean-up's error code).
+TEST(AtomicFile, ADirectoryInTheWayIsNamedNotSuccess) {
+  const auto dir = fresh_dir("atomic-dir");
+  fs::create_directories(dir / "model.onnx" / "inside");
+  try {
+    write_file_atomic(dir / "model.onnx", "bytes");
+    FAIL();
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find("Success"), std::string::npos) << what;
+    EXPECT_NE(what.find("model.onnx: cannot move the finished file into place: a directory of that name is in the way"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_EQ(file_count(dir), 1u);  // the temporary is gone
+}
+

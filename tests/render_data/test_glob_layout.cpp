@@ -116,5 +116,37 @@ TEST(GlobLayout, RgbaColourLoadsAndHdrColourIsRejectedByFileAndFrame) {
   }
 }
 
+// A '*' in the capture's own folder name is a name, not a wildcard (it used to be refused).
+TEST(GlobLayout, ACaptureFolderNamedWithAStarLoads) {
+  const fs::path root = write_capture("glob_star*[1]", 2);
+  EXPECT_EQ(Dataset::open(root).frame_count(), 2);
+  // A wildcard in the pattern's own folders is still refused.
+  std::ofstream(root / "dataset.yaml") << "layout: glob\nresolutions:\n  - size: 32x24\n    color: l*/color_*.png\n";
+  try {
+    Dataset::open(root);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("l*/color_*.png: wildcards are only supported in the file name"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A capture description with a YAML syntax error says where, not "not a dataset in any layout".
+TEST(GlobLayout, ASyntaxErrorInTheCaptureYamlNamesItsLine) {
+  const fs::path root = write_capture("glob_syntax", 1);
+  std::ofstream(root / "dataset.yaml") << "layout: glob\nresolutions:\n  - size: [32x24\n    color: lr/color_*.png\n";
+  try {
+    Dataset::open(root);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.kind(), ErrorKind::User);
+    EXPECT_EQ(what.find("not a dataset"), std::string::npos) << what;
+    EXPECT_NE(what.find((root / "dataset.yaml").string() + ":"), std::string::npos) << what;
+    EXPECT_NE(what.find("invalid YAML"), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace cgsr
