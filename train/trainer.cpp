@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/enum_names.h"
@@ -261,7 +262,11 @@ void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const
   archive.write("outcome", text_tensor(state.dump()));
   archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
   archive.write("layout", text_tensor(enum_name(layout_)));
-  write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
+  // Serialized in memory: LibTorch's file writer throws from its destructor on a full disk, which
+  // ends the process; the atomic writer reports it and keeps the last good checkpoint.
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  write_file_atomic(path, bytes.str());
 }
 
 bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, TrainOutcome& outcome) {

@@ -67,3 +67,22 @@ TEST(AtomicFile, ADirectoryInTheWayIsNamedNotSuccess) {
   EXPECT_EQ(file_count(dir), 1u);  // the temporary is gone
 }
 
+// A full disk is a user error naming the file and the fix; the old file stays, no temporary is
+// left, and other files are still written (CGSR_FAULT_NO_SPACE counts per file name).
+TEST(AtomicFile, AFullDiskKeepsTheOldFileAndSaysWhatToDo) {
+  const auto dir = fresh_dir("atomic-no-space");
+  ::setenv("CGSR_FAULT_NO_SPACE", "model.cgsr@1", 1);
+  write_file_atomic(dir / "model.cgsr", "good");
+  try {
+    write_file_atomic(dir / "model.cgsr", "newer");
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::User);
+    EXPECT_EQ(e.context(), (dir / "model.cgsr").string());
+    EXPECT_EQ(e.message(), "cannot write: no space left on the device; free some space there or choose another --out");
+  }
+  write_file_atomic(dir / "other.txt", "fine");
+  ::unsetenv("CGSR_FAULT_NO_SPACE");
+  EXPECT_EQ(read_file(dir / "model.cgsr"), "good");
+  EXPECT_EQ(file_count(dir), 2u);
+}

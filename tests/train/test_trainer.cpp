@@ -352,3 +352,56 @@ TEST(Trainer, PhaseTimesKeepTheirJsonFormat) {
                                            R"("optimizer":0.25,"validation":0.0,"checkpoint":0.125})");
   EXPECT_EQ(to_json(o)["layout"], "nchw");
 }
+
+namespace {
+std::string train_command(const std::filesystem::path& out) {
+  return "train --data " + tiny_data().string() +
+         " --model pan --threads 1 --set schedule.steps=4 --set schedule.checkpoint_every=2"
+         " --set schedule.batch_size=2 --set schedule.patch_size=16 --set schedule.val_frames=1 --out " +
+         out.string();
+}
+
+size_t temporaries_in(const std::filesystem::path& dir) {
+  size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
+  return n;
+}
+}  // namespace
+
+// A full disk at a checkpoint used to end the process (SIGABRT from LibTorch's archive writer)
+// and leave checkpoint.pt.tmp-PID behind. Now: exit 2 naming the file and the fix, no temporary
+// left, the last good checkpoint kept, and --resume goes on from it.
+TEST(TrainCommand, AFullDiskAtACheckpointExitsTwoAndResumeGoesOnFromTheLastGoodOne) {
+  const auto out = scratch_dir("train-full-disk") / "run";
+  ::setenv("CGSR_FAULT_NO_SPACE", "checkpoint.pt@1", 1);  // the step-2 checkpoint is written, step 4's is not
+  auto r = run_cgsr(train_command(out));
+  ::unsetenv("CGSR_FAULT_NO_SPACE");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find((out / "checkpoint.pt").string() + ": cannot write: no space left on the device"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("terminate called"), std::string::npos) << r.err;
+  EXPECT_EQ(temporaries_in(out), 0u);
+  ASSERT_TRUE(std::filesystem::exists(out / "checkpoint.pt"));
+  EXPECT_FALSE(std::filesystem::exists(out / "results.json"));
+
+  r = run_cgsr(train_command(out) + " --resume");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("at step 2/4"), std::string::npos) << r.err;
+  EXPECT_TRUE(read_json(out / "results.json")["training"]["resumed"].get<bool>());
+}
+
+// The same on a real full file system, where the machine allows mounting one (root).
+TEST(TrainCommand, ACheckpointOnASmallTmpfsExitsTwoAndLeavesNoTemporary) {
+  const auto mount_point = scratch_dir("train-tmpfs");
+  const std::string mount = "mount -t tmpfs -o size=3M tmpfs " + mount_point.string() + " 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0) GTEST_SKIP() << "cannot mount a tmpfs here";
+  const auto r = run_cgsr(train_command(mount_point / "tr"));
+  const size_t left = temporaries_in(mount_point / "tr");
+  std::system(("umount " + mount_point.string()).c_str());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no space left on the device"), std::string::npos) << r.err;
+  EXPECT_EQ(left, 0u);
+}
+
