@@ -192,7 +192,7 @@ class GlobDataset : public FrameSource {
     // Reads one file, checked for size and NaN/Inf, and decodes it; errors name file and frame.
     auto decode = [&](const fs::path& p, const char* what, auto&& decoder) {
       try {
-        const ImageFile image = read_image_file(p);
+        const ImageFile image = read_image_file(p, {0, r.width, r.height});
         check_image_size(image.pixels, r, p.string(), frame);
         check_finite(image.pixels, p.string(), frame, what);
         return decoder(image);

@@ -148,5 +148,27 @@ TEST(GlobLayout, ASyntaxErrorInTheCaptureYamlNamesItsLine) {
   }
 }
 
+// A capture frame whose header declares far more pixels than its resolution is refused before it
+// is decoded, naming the file and the frame (fuzz/corpus's bomb seed: 1 KB, 20000x20000).
+TEST(GlobLayout, ADecompressionBombFrameIsRefusedNamingTheFile) {
+  const fs::path root = write_capture("glob_bomb", 2);
+  std::ifstream in(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/frame_files/color_bomb_20000x20000.bin",
+                   std::ios::binary);
+  in.get();  // the seed's file-kind byte
+  std::ofstream(root / "hr" / "frame1.png", std::ios::binary | std::ios::trunc) << in.rdbuf();
+  const Dataset data = Dataset::open(root);
+  try {
+    data.frame(1, 1);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::User);
+    EXPECT_NE(std::string(e.what()).find((root / "hr" / "frame1.png").string() +
+                                         ": frame 1: size 20000x20000 (from the PNG header; not decoded) does "
+                                         "not match the resolution 64x48"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace cgsr
