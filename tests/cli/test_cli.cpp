@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "tests/support/child_process.h"
 #include "tests/support/cli_runner.h"
 
 using cgsr::test::run_cgsr;
@@ -90,5 +91,45 @@ TEST(Cli, AListAsAKeyInAStageSectionIsAUserErrorAtItsLine) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(file.string() + ":4:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("a key must be a name"), std::string::npos) << r.err;
+}
+
+// One writer per run directory: while one command holds a directory, a second one exits 2
+// naming the holder's PID (it used to write into it too, both exiting 0 with a mixed result).
+TEST(Cli, ASecondCommandOnARunDirectoryInUseExitsTwoNamingTheHolder) {
+  const auto dir = scratch_dir("cli-lock");
+  const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
+  cgsr::test::CgsrProcess first(
+      {"render", "--config", tiny, "--set", "frames=400", "--threads", "1", "--out", (dir / "data").string()},
+      dir / "first");
+  const std::string holder = std::to_string(first.pid()) + " render";
+  ASSERT_TRUE(first.wait_for([&] { return cgsr::test::slurp(dir / "data" / ".cgsr.lock").rfind(holder, 0) == 0; },
+                             std::chrono::seconds(60)))
+      << cgsr::test::slurp(dir / "first.err");
+  const auto second = run_cgsr("render --config " + tiny + " --set frames=400 --out " + (dir / "data").string());
+  first.kill();
+  EXPECT_EQ(second.exit_code, 2) << second.err;
+  EXPECT_NE(second.err.find((dir / "data").string() + ": is in use by another command ('cgsr render', pid " +
+                            std::to_string(first.pid()) + ")"),
+            std::string::npos)
+      << second.err;
+}
+
+// A directory that belongs to another command is refused unless --force; the lock dies with its
+// holder, so the directory is free again once that ends.
+TEST(Cli, ARunDirectoryOfAnotherCommandIsRefusedUnlessForced) {
+  const auto dir = scratch_dir("cli-kind") / "run";
+  ASSERT_EQ(run_cgsr("info --out " + dir.string()).exit_code, 0);
+  ASSERT_EQ(run_cgsr("info --out " + dir.string()).exit_code, 0);  // the same command may rerun
+  const std::string render =
+      "render --config " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --set frames=1 --out " + dir.string();
+  auto r = run_cgsr(render);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(dir.string() + ": belongs to 'cgsr info' (.cgsr.lock); choose another --out, or pass --force"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(cgsr::read_file(dir / "config.yaml").find("scene"), std::string::npos);  // info's config is untouched
+  r = run_cgsr(render + " --force");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(cgsr::read_file(dir / ".cgsr.lock").find(" render"), std::string::npos);
 }
 
