@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -20,11 +21,70 @@ struct Document::Data {
 
 Document::Document() : data_(std::make_shared<Data>()) {}
 
+namespace {
+// Bounds of a config, checked before (bytes) and right after (the rest) yaml-cpp reads it, before
+// any schema walks it: the largest config in configs/ is a few KiB, and a 10 MB list took 1.7 GB.
+constexpr size_t kMaxConfigBytes = size_t{1} << 20;
+constexpr size_t kMaxListItems = 100000;
+constexpr size_t kMaxValues = 1000000;  // every node counted, aliases as often as they are used
+constexpr int kMaxDepth = 64;
+
+std::string mark_text(const std::string& origin, const YAML::Mark& mark) {
+  if (mark.is_null()) return origin;
+  return origin + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+void check_size(size_t bytes, const std::string& origin) {
+  if (bytes > kMaxConfigBytes)
+    throw Error(origin, "the config is " + std::to_string(bytes) + " bytes, more than the limit of " +
+                            std::to_string(kMaxConfigBytes) + " (1 MiB)");
+}
+
+// Duplicate keys (yaml-cpp keeps both and reads the first), and lists, values and nesting beyond
+// the bounds above.
+void check_structure(const YAML::Node& node, const std::string& origin, int depth, size_t& values) {
+  if (++values > kMaxValues)
+    throw Error(mark_text(origin, node.Mark()), "more than " + std::to_string(kMaxValues) +
+                                                    " values (counting each use of an alias)");
+  if (depth > kMaxDepth)
+    throw Error(mark_text(origin, node.Mark()), "nested deeper than " + std::to_string(kMaxDepth) + " levels");
+  if (node.IsSequence()) {
+    if (node.size() > kMaxListItems)
+      throw Error(mark_text(origin, node.Mark()), "a list of " + std::to_string(node.size()) +
+                                                      " items, more than the limit of " + std::to_string(kMaxListItems));
+    for (const auto& item : node) check_structure(item, origin, depth + 1, values);
+  } else if (node.IsMap()) {
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      if (kv.first.IsScalar()) {
+        const auto [first, inserted] = seen.emplace(kv.first.Scalar(), kv.first.Mark());
+        if (!inserted)
+          throw Error(mark_text(origin, kv.first.Mark()),
+                      "duplicate key '" + kv.first.Scalar() + "' (first at line " +
+                          std::to_string(first->second.line + 1) + "); keep one");
+      }
+      check_structure(kv.second, origin, depth + 1, values);
+    }
+  }
+}
+
+YAML::Node load_checked(const std::string& text, const std::string& origin) {
+  check_size(text.size(), origin);
+  YAML::Node root = YAML::Load(text);
+  size_t values = 0;
+  check_structure(root, origin, 0, values);
+  return root;
+}
+}  // namespace
+
 Document Document::load_file(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) {
     throw Error(path.string(), std::filesystem::exists(path) ? "cannot read the file" : "no such config file");
   }
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (!ec) check_size(bytes, path.string());  // before reading it
   std::stringstream text;
   text << in.rdbuf();
   return parse(text.str(), path.string());
@@ -34,7 +94,7 @@ Document Document::parse(const std::string& text, const std::string& origin) {
   Document doc;
   doc.data_->origin = origin;
   try {
-    YAML::Node root = YAML::Load(text);
+    YAML::Node root = load_checked(text, origin);
     if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
     doc.data_->root = root;
   } catch (const YAML::Exception& e) {
@@ -55,7 +115,7 @@ void Document::apply_override(const std::string& assignment, const std::string& 
 
   YAML::Node value;
   try {
-    value = YAML::Load(assignment.substr(eq + 1));
+    value = load_checked(assignment.substr(eq + 1), where);
   } catch (const YAML::Exception& e) {
     throw Error(where, "the value is not valid YAML: " + e.msg);
   }

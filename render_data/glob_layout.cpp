@@ -259,11 +259,12 @@ bool looks_like_glob_layout(const fs::path& path) {
   const auto ext = yaml.extension().string();
   if (ext != ".yaml" && ext != ".yml") return false;
   try {
-    const YAML::Node n = YAML::LoadFile(yaml.string());
+    const YAML::Node n = config::Document::load_file(yaml).root();
     return n.IsMap() && n["layout"] && n["layout"].IsScalar() && n["layout"].Scalar() == "glob";
-  } catch (const YAML::Exception&) {
-    // A YAML file that does not parse can only be meant as a capture: opening it reports the
-    // syntax error with its line and column, not "not a dataset".
+  } catch (const Error&) {
+    // A YAML file that does not load (a syntax error, a duplicate key, too large) can only be
+    // meant as a capture: opening it reports the error with its line and column, not "not a
+    // dataset".
     return true;
   }
 }

@@ -4,6 +4,8 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "core/config.h"
@@ -355,3 +357,52 @@ TEST(Config, AKeyThatIsAListReachesJsonAsItsYamlText) {
   EXPECT_EQ(j["train"]["steps"], 3);
 }
 
+// Duplicate keys were accepted silently (yaml-cpp reads the first); now an error naming both lines.
+TEST(Config, DuplicateKeysAreAnErrorNamingBothLines) {
+  auto e = error_of("name: hall\nframes: 3\ncamera: {fov: 70}\nframes: 4\n");
+  EXPECT_NE(e.find("scene.yaml:4:1: duplicate key 'frames' (first at line 2); keep one"), std::string::npos) << e;
+  e = error_of("name: hall\ncamera:\n  fov: 70\n  fov: 80\n");
+  EXPECT_NE(e.find("scene.yaml:4:3: duplicate key 'fov' (first at line 3)"), std::string::npos) << e;
+  e = error_of("name: hall\n", {"camera={fov: 1, fov: 2}"});
+  EXPECT_NE(e.find("duplicate key 'fov'"), std::string::npos) << e;
+}
+
+// A 10 MB list took 1.68 GB and --check called it valid; 50 MB died with std::bad_alloc. The size
+// is checked before yaml-cpp reads the text, lists and values right after, before any schema.
+TEST(Config, ConfigsAreBoundedBeforeTheyAreParsed) {
+  std::string big = "name: hall\nlights: [";
+  while (big.size() <= (size_t{1} << 20)) big += "{}, ";
+  big += "{}]\n";
+  auto e = error_of(big);
+  EXPECT_NE(e.find("scene.yaml: the config is " + std::to_string(big.size()) +
+                   " bytes, more than the limit of 1048576 (1 MiB)"),
+            std::string::npos)
+      << e.substr(0, 300);
+  std::string list = "name: hall\ncamera: {position: [";
+  for (int i = 0; i < 100001; ++i) list += "0,";
+  list += "0]}\n";
+  e = error_of(list);
+  EXPECT_NE(e.find("scene.yaml:2:"), std::string::npos) << e.substr(0, 300);
+  EXPECT_NE(e.find("a list of 100002 items, more than the limit of 100000"), std::string::npos)
+      << e.substr(0, 300);
+  // Aliases reuse a node without copying it: counted as often as they are used.
+  std::string laughs = "l0: &l0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+  for (int level = 1; level <= 7; ++level) {  // 10^8 values from a few hundred bytes
+    const std::string previous = "*l" + std::to_string(level - 1);
+    laughs += "l" + std::to_string(level) + ": &l" + std::to_string(level) + " [" + previous;
+    for (int i = 1; i < 10; ++i) laughs += ", " + previous;
+    laughs += "]\n";
+  }
+  e = error_of(laughs);
+  EXPECT_NE(e.find("more than 1000000 values (counting each use of an alias)"), std::string::npos) << e;
+  // A file too large is refused before it is read.
+  const auto file = std::filesystem::temp_directory_path() / ("cgsr-big-config-" + std::to_string(::getpid()) + ".yaml");
+  { std::ofstream(file) << big; }
+  try {
+    Document::load_file(file);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("more than the limit of 1048576"), std::string::npos) << err.what();
+  }
+  std::filesystem::remove(file);
+}
