@@ -13,6 +13,7 @@
 #include "core/runtime.h"
 #include "models/arch_spec.h"
 #include "tests/support/tiny_data.h"
+#include "train/run_identity.h"
 #include "train/trainer.h"
 
 using namespace cgsr;
@@ -405,3 +406,44 @@ TEST(TrainCommand, ACheckpointOnASmallTmpfsExitsTwoAndLeavesNoTemporary) {
   EXPECT_EQ(left, 0u);
 }
 
+// --resume with another seed, batch size or data set was accepted silently; now the differences
+// are listed and the run exits 2, unless --force, which goes on and records them. A longer
+// schedule is not a difference: that is what resuming is for.
+TEST(TrainCommand, ResumingWithAnotherSeedOrScheduleExitsTwoListingTheDifferences) {
+  const auto out = scratch_dir("train-resume-identity") / "run";
+  auto r = run_cgsr(train_command(out) + " --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cgsr(train_command(out) + " --seed 4 --set schedule.batch_size=4 --set schedule.steps=6 --resume");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find((out / "checkpoint.pt").string() + ": was written by a different run"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("  seed: 3 in the checkpoint, 4 now"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("  schedule.batch_size: 2 in the checkpoint, 4 now"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("schedule.steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pass --force"), std::string::npos) << r.err;
+
+  r = run_cgsr(train_command(out) + " --seed 3 --set schedule.steps=6 --resume");  // only longer: fine
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(read_json(out / "results.json")["training"].contains("resume_overrides"));
+
+  r = run_cgsr(train_command(out) + " --seed 4 --set schedule.steps=8 --resume --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto overrides = read_json(out / "results.json")["training"]["resume_overrides"];
+  ASSERT_EQ(overrides.size(), 1u) << overrides.dump();
+  EXPECT_EQ(overrides[0], "seed: 3 in the checkpoint, 4 now");
+}
+
+// The data set's fingerprint: another data set (or the same one with other frames) differs.
+TEST(RunIdentity, TheDataSetFingerprintTellsDataSetsApart) {
+  const Dataset data = Dataset::open(tiny_data());
+  const ArchSpec spec = small_pan();
+  const TrainSchedule schedule = short_schedule(MemoryLayout::Nchw);
+  const RunIdentity now = run_identity(3, schedule, data.info(), spec);
+  EXPECT_TRUE(identity_differences(now, now).empty());
+  DatasetInfo other = data.info();
+  other.frames += 1;
+  other.name = "other";
+  const auto differences = identity_differences(run_identity(3, schedule, other, spec), now);
+  ASSERT_EQ(differences.size(), 1u);
+  EXPECT_EQ(differences[0].rfind("data: cgsr 'other', 7 frames", 0), 0u) << differences[0];
+}
