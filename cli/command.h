@@ -14,6 +14,7 @@
 #include "core/config.h"
 #include "core/run_dir.h"
 #include "core/run_dir_lock.h"
+#include "core/utf8.h"
 #include "models/memory_layout.h"
 #include "pipeline/run_settings.h"
 
@@ -69,6 +70,9 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
   // The command as its run directory records it: "train", "data merge".
   const std::string command = app.get_name().empty() ? name : app.get_name() + " " + name;
   sub->callback([=]() {
+    // Before any work: paths reach JSON files, which must be UTF-8 (core/utf8.h).
+    require_utf8(globals().out, "--out", "the path");
+    require_utf8(globals().config_file, "--config", "the path");
     const auto the_schema = schema();
     const config::Document doc = build_document(*assignments);
     const T options = config::parse_document(doc, the_schema);

@@ -2,13 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
+
+#include "core/utf8.h"
 
 namespace cgsr::config {
 
@@ -68,8 +72,23 @@ void check_structure(const YAML::Node& node, const std::string& origin, int dept
   }
 }
 
+// Config values reach JSON files (results.json, manifests, model files), which must be UTF-8.
+void check_utf8(const std::string& text, const std::string& origin) {
+  const auto bad = first_invalid_utf8(text);
+  if (!bad) return;
+  const size_t newline = *bad == 0 ? std::string::npos : text.rfind('\n', *bad - 1);
+  const size_t line_start = newline == std::string::npos ? 0 : newline + 1;
+  const size_t line = 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + static_cast<long>(*bad), '\n'));
+  const size_t column = *bad - line_start + 1;
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned char>(text[*bad]));
+  throw Error(origin + ":" + std::to_string(line) + ":" + std::to_string(column),
+              std::string("not valid UTF-8 (byte ") + hex + "); config values are written to JSON files, which must be UTF-8");
+}
+
 YAML::Node load_checked(const std::string& text, const std::string& origin) {
   check_size(text.size(), origin);
+  check_utf8(text, origin);
   YAML::Node root = YAML::Load(text);
   size_t values = 0;
   check_structure(root, origin, 0, values);

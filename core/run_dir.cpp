@@ -25,7 +25,10 @@ void RunDir::write_config(const YAML::Node& resolved) const {
 }
 
 void RunDir::write_results(const nlohmann::ordered_json& results) const {
-  write_file_atomic(file("results.json"), results.dump(2) + "\n");
+  // Inputs are checked for UTF-8 before a command starts (core/utf8.h); a name read from disk
+  // that is not still must not cost the results at the very end, so it is replaced, not thrown.
+  write_file_atomic(file("results.json"),
+                    results.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n");
 }
 
 std::filesystem::path default_run_dir(const std::string& command) {

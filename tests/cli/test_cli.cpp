@@ -133,3 +133,17 @@ TEST(Cli, ARunDirectoryOfAnotherCommandIsRefusedUnlessForced) {
   EXPECT_NE(cgsr::read_file(dir / ".cgsr.lock").find(" render"), std::string::npos);
 }
 
+// A non-UTF-8 --out used to pass every check and fail at the very end (exit 1, json type_error
+// 316, no results.json); now it is refused before the directory is made.
+TEST(Cli, ANonUtf8OutPathIsRefusedBeforeAnyWork) {
+  const auto dir = scratch_dir("cli-utf8");
+  const std::string bad = (dir / "caf\xE9").string();
+  auto r = run_cgsr("info --out '" + bad + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("error: --out: the path is not valid UTF-8 (byte 0xE9"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+  r = run_cgsr("info --set \"name=caf\xE9\" --out " + (dir / "ok").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("not valid UTF-8 (byte 0xE9)"), std::string::npos) << r.err;
+}
+
