@@ -30,6 +30,7 @@ struct GlobalOptions {
   bool print_config = false;       // --print-config
   bool check = false;              // --check
   bool force = false;              // --force
+  bool verbose = false;            // --verbose
 };
 
 GlobalOptions& globals();

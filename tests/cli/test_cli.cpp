@@ -147,3 +147,41 @@ TEST(Cli, ANonUtf8OutPathIsRefusedBeforeAnyWork) {
   EXPECT_NE(r.err.find("not valid UTF-8 (byte 0xE9)"), std::string::npos) << r.err;
 }
 
+// A read-only --out was an internal error (exit 1, "Failed opening .../log.txt.partial"); it is
+// the user's to fix: exit 2 naming the directory and what to do. Needs a read-only mount (root).
+TEST(Cli, AReadOnlyOutExitsTwoNamingTheFix) {
+  const auto dir = scratch_dir("cli-read-only");
+  const std::string mount = "mount -t tmpfs -o ro,size=1M tmpfs " + dir.string() + " 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0) GTEST_SKIP() << "cannot mount a read-only tmpfs here";
+  const auto r = run_cgsr("info --out " + (dir / "run").string());
+  std::system(("umount " + dir.string()).c_str());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("the file system is read-only; choose another --out"), std::string::npos) << r.err;
+}
+
+// Memory for the sizes asked for is the machine's limit, not a bug: exit 2 with the fix, and no
+// LibTorch backtrace (it printed 40 frames).
+TEST(Cli, OutOfMemoryForTheRequestedSizeExitsTwoWithoutABacktrace) {
+  const auto r = run_cgsr("bench --model pan --input 16000x16000 --batch 64 --runs 1 --warmup 0 --threads 1");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("error: out of memory: the sizes asked for"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("frame #"), std::string::npos) << r.err;
+}
+
+// --check makes the checks the run makes: a render resolution beyond what cgsr reads back, and a
+// scene option out of range (scene.size=[100000,100000] used to pass --check and fail the run).
+TEST(Cli, RenderCheckAppliesTheRunsRangeChecks) {
+  const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
+  auto r = run_cgsr("render --config " + tiny + " --check");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("triangles, 6 frames at 64x48, 128x96"), std::string::npos) << r.out;
+  r = run_cgsr("render --config " + tiny + " --set scene.size=[100000,100000] --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--set scene.size=[100000,100000]: scene.size[0]: '100000' is out of range [3, 200]"),
+            std::string::npos)
+      << r.err;
+  r = run_cgsr("render --config " + tiny + " --set resolutions=[20000x15000,40000x30000] --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("resolution 20000x15000 is out of range: at most 16384 pixels a side"), std::string::npos)
+      << r.err;
+}
