@@ -21,6 +21,10 @@ void add_global_options(CLI::App& app) {
   app.add_option("--threads", g.threads, "LibTorch and TBB threads (0 = all hardware threads)");
   app.add_option("--seed", g.seed, "seed for every random number generator");
   app.add_flag("--print-config", g.print_config, "print the resolved config of the command and exit");
+  app.add_flag("--force", g.force,
+               "write into a run directory that belongs to another command; --resume: go on despite differences "
+               "from the checkpoint");
+  app.add_flag("--verbose", g.verbose, "internal errors: with LibTorch's backtrace");
   app.add_flag("--check", g.check,
                "check the config and exit without running or writing anything (cgsr run: every stage's section "
                "and every scene config it names too)");

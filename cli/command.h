@@ -13,6 +13,8 @@
 
 #include "core/config.h"
 #include "core/run_dir.h"
+#include "core/run_dir_lock.h"
+#include "core/utf8.h"
 #include "models/memory_layout.h"
 #include "pipeline/run_settings.h"
 
@@ -27,6 +29,8 @@ struct GlobalOptions {
   std::optional<int64_t> seed;     // --seed N
   bool print_config = false;       // --print-config
   bool check = false;              // --check
+  bool force = false;              // --force
+  bool verbose = false;            // --verbose
 };
 
 GlobalOptions& globals();
@@ -64,7 +68,12 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
   CLI::App* sub = app.add_subcommand(name, description);
   auto assignments = std::make_shared<std::vector<FlagAssignment>>();
   if (flags) flags(*sub, *assignments);
+  // The command as its run directory records it: "train", "data merge".
+  const std::string command = app.get_name().empty() ? name : app.get_name() + " " + name;
   sub->callback([=]() {
+    // Before any work: paths reach JSON files, which must be UTF-8 (core/utf8.h).
+    require_utf8(globals().out, "--out", "the path");
+    require_utf8(globals().config_file, "--config", "the path");
     const auto the_schema = schema();
     const config::Document doc = build_document(*assignments);
     const T options = config::parse_document(doc, the_schema);
@@ -79,10 +88,12 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
       return;
     }
     begin_command(options);
+    std::unique_ptr<RunDirLock> lock;  // released after the run directory's log is finished
     std::unique_ptr<RunDir> run_dir;
     if (!globals().out.empty() || always_run_dir) {
       std::filesystem::path dir = globals().out.empty() ? default_run_dir(name) : std::filesystem::path(globals().out);
       if (place_run_dir) dir = place_run_dir(options, dir);
+      lock = std::make_unique<RunDirLock>(dir, command, globals().force);
       run_dir = std::make_unique<RunDir>(dir);
     }
     if (run_dir) run_dir->write_config(resolved);

@@ -1,12 +1,11 @@
 // cgsr: lightweight super-resolution for real-time graphics. main() only wires subcommands
-// and turns errors into messages and exit codes (2 for user errors, 1 for internal ones).
+// and turns errors into messages and exit codes (2 for user errors and the machine's limits, 1
+// for internal ones: cli/failure.h).
 
 #include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
-
-#include <cstdio>
 
 #include "cli/command.h"
+#include "cli/failure.h"
 #include "cli/commands/ablate.h"
 #include "cli/commands/bench.h"
 #include "cli/commands/data_check.h"
@@ -19,7 +18,6 @@
 #include "cli/commands/run.h"
 #include "cli/commands/search.h"
 #include "cli/commands/train.h"
-#include "core/error.h"
 #include "core/logging.h"
 
 int main(int argc, char** argv) {
@@ -48,15 +46,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
-  } catch (const cgsr::Error& e) {
-    spdlog::debug("{}", e.what());
-    std::fprintf(stderr, "error: %s\n", e.what());
+  } catch (...) {
+    const int code = report_failure(std::current_exception(), globals().verbose);
     cgsr::finish_log_file();
-    return e.kind() == cgsr::ErrorKind::User ? 2 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: internal: %s\n", e.what());
-    cgsr::finish_log_file();
-    return 1;
+    return code;
   }
   cgsr::finish_log_file();
   return 0;

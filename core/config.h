@@ -86,6 +86,12 @@ struct Codec;
 
 namespace detail {
 std::string describe(const YAML::Node& node);  // "'abc'", "a list", "a map", "null"
+std::string number(double x);                   // 3, 0.5, 1e+15: as short as it reads
+// "'1e15' is out of range [1, 1000000]" at `node` (or at the first element of a list outside it)
+// when the number or any element of the list of numbers at `node` lies outside [lo, hi].
+void check_range(const YAML::Node& node, double lo, double hi, const Cursor& at);
+// The same for a converted value `v` written at `node`.
+void require_in_range(double v, double lo, double hi, const YAML::Node& node, const Cursor& at);
 // `map` with the keys of each block named in `moved` lifted to its level (Schema::moved_block),
 // warning once per block where it was written.
 YAML::Node lift_moved_blocks(const YAML::Node& map, const std::vector<std::string>& moved, const Cursor& at);
@@ -108,7 +114,22 @@ struct Codec<bool> {
 
 template <class V>
 struct Codec<V, std::enable_if_t<std::is_integral_v<V> && !std::is_same_v<V, bool>>> {
-  static V decode(const YAML::Node& n, const Cursor& at) { return detail::scalar_as<V>(n, at, "an integer"); }
+  static V decode(const YAML::Node& n, const Cursor& at) {
+    if (n.IsScalar()) {
+      V v{};
+      if (YAML::convert<V>::decode(n, v)) return v;
+      // A whole number written as 1e3, or one too large for the field, is not a type mistake.
+      double x = 0;
+      if (YAML::convert<double>::decode(n, x) && std::isfinite(x) && x == std::floor(x)) {
+        const double lo = static_cast<double>(std::numeric_limits<V>::lowest());
+        const double hi = static_cast<double>(std::numeric_limits<V>::max());
+        if (x >= lo && x < hi) return static_cast<V>(x);
+        at.fail(n, detail::describe(n) + " is out of range [" + std::to_string(std::numeric_limits<V>::lowest()) +
+                       ", " + std::to_string(std::numeric_limits<V>::max()) + "]");
+      }
+    }
+    return detail::scalar_as<V>(n, at, "an integer");
+  }
   static YAML::Node encode(V v) { return YAML::Node(v); }
 };
 
@@ -174,15 +195,29 @@ class Schema {
       schema_.fields_[index_].required = true;
       return *this;
     }
-    // Inclusive range; for lists, every element.
+    // Inclusive range; for lists, every element. Checked on the written number before it is
+    // converted, so a value too large for the field's type is out of range, not of a wrong type.
     FieldBuilder& range(double lo, double hi) {
-      return check([lo, hi](const V& v) { return in_range(v, lo, hi); },
-                   "must be in [" + number(lo) + ", " + number(hi) + "]");
+      static_assert(std::is_arithmetic_v<V> || std::is_arithmetic_v<typename ValueOf<V>::type>,
+                    "range() needs a numeric field");
+      auto& f = schema_.fields_[index_];
+      auto previous = f.validate;
+      f.validate = [previous, lo, hi](const T& obj, const YAML::Node& node, const Cursor& at, const void* member) {
+        if (previous) previous(obj, node, at, member);
+        // Again on the value: a spelling the number check does not read (0x10) converts too.
+        const auto& v = *static_cast<const V*>(member);
+        if constexpr (std::is_arithmetic_v<V>) {
+          detail::require_in_range(static_cast<double>(v), lo, hi, node, at);
+        } else {
+          for (size_t i = 0; i < v.size(); ++i)
+            detail::require_in_range(static_cast<double>(v[i]), lo, hi, node.IsSequence() ? node[i] : node,
+                                     at.index(i));
+        }
+      };
+      f.bounds = {lo, hi};
+      return *this;
     }
-    FieldBuilder& at_least(double lo) {
-      return check([lo](const V& v) { return in_range(v, lo, std::numeric_limits<double>::infinity()); },
-                   "must be at least " + number(lo));
-    }
+    FieldBuilder& at_least(double lo) { return range(lo, std::numeric_limits<double>::infinity()); }
     FieldBuilder& one_of(std::vector<std::string> allowed) {
       auto& f = schema_.fields_[index_];
       auto previous = f.validate;
@@ -205,25 +240,14 @@ class Schema {
     }
 
    private:
-    static std::string number(double x) {
-      std::string s = std::to_string(x);
-      s.erase(s.find_last_not_of('0') + 1);
-      if (!s.empty() && s.back() == '.') s.pop_back();
-      return s;
-    }
     template <class X>
-    static bool in_range(const X& v, double lo, double hi) {
-      if constexpr (std::is_arithmetic_v<X>) {
-        return static_cast<double>(v) >= lo && static_cast<double>(v) <= hi;
-      } else if constexpr (std::is_same_v<X, std::vector<typename X::value_type>>) {
-        for (const auto& x : v)
-          if (!in_range(x, lo, hi)) return false;
-        return true;
-      } else {
-        static_assert(std::is_arithmetic_v<X>, "range() needs a numeric field");
-        return false;
-      }
-    }
+    struct ValueOf {
+      using type = X;
+    };
+    template <class X>
+    struct ValueOf<std::vector<X>> {
+      using type = X;
+    };
     template <class X>
     static void check_allowed(const X& v, const std::vector<std::string>& allowed, const YAML::Node& node,
                               const Cursor& at) {
@@ -307,6 +331,7 @@ class Schema {
       f.emit = [member, e = inner.emit](const T& obj) { return e(obj.*member); };
       if (inner.member) f.member = [member, m = inner.member](const T& obj) { return m(obj.*member); };
       if (inner.omit) f.omit = [member, o = inner.omit](const T& obj) { return o(obj.*member); };
+      f.bounds = inner.bounds;
       if (inner.validate)
         f.validate = [member, v = inner.validate](const T& obj, const YAML::Node& node, const Cursor& at,
                                                   const void* field) { v(obj.*member, node, at, field); };
@@ -377,6 +402,7 @@ class Schema {
                                                                     "; valid keys: " + join(keys()));
         }
         seen.insert(key);
+        if (f->bounds) detail::check_range(kv.second, f->bounds->first, f->bounds->second, at.child(key));
         f->parse(kv.second, out, at.child(key));
         if (f->validate) f->validate(out, kv.second, at.child(key), f->member(out));
       }
@@ -415,6 +441,7 @@ class Schema {
     std::function<YAML::Node(const T&)> emit;
     std::function<const void*(const T&)> member;
     std::function<void(const T&, const YAML::Node&, const Cursor&, const void*)> validate;
+    std::optional<std::pair<double, double>> bounds;  // range(): checked before decoding too
   };
   const Field* find(const std::string& key) const {
     for (const auto& f : fields_)

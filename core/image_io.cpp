@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/image_header.h"
 #include "core/tensor_checks.h"
 
 namespace cgsr {
@@ -68,6 +69,15 @@ cv::Mat to_mat(const torch::Tensor& image, int bits, const std::string& context)
   if (c == 4) cv::cvtColor(mat, mat, cv::COLOR_RGBA2BGRA);
   return mat;
 }
+// Before decoding: the decoder allocates whatever the header declares.
+void check_declared_size(const ImageHeader& header, const ImageReadOptions& options, const std::string& context) {
+  // Worded as the decoded size check of the data-set readers, which `data check` counts by it.
+  if (options.width > 0 && options.height > 0 && (header.width != options.width || header.height != options.height))
+    throw Error(context, "size " + std::to_string(header.width) + "x" + std::to_string(header.height) + " (from the " +
+                             header.format + " header; not decoded) does not match the resolution " +
+                             std::to_string(options.width) + "x" + std::to_string(options.height));
+  check_image_limits(header, context);  // also for a frame size that is itself too large
+}
 }  // namespace
 
 torch::Tensor read_image(const fs::path& path, const ImageReadOptions& options) {
@@ -78,6 +88,7 @@ ImageFile read_image_file(const fs::path& path, const ImageReadOptions& options)
   enable_exr();
   const std::string context = path.string();
   if (!fs::exists(path)) throw Error(context, "no such image file");
+  check_declared_size(read_image_header(path), options, context);
   cv::Mat mat = cv::imread(path.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
   if (mat.empty()) throw Error(context, "unreadable image (corrupt, truncated or an unsupported format)");
   const int c = mat.channels();

@@ -1,7 +1,8 @@
 #pragma once
 // Image files <-> CPU float32 CHW tensors.
 //   read:  8-bit and 16-bit PNG/PPM/PGM/BMP/TIFF/JPEG scaled to [0,1]; 32-bit float TIFF and EXR
-//          as stored.
+//          as stored. The size a file declares is read from its header first
+//          (core/image_header.h) and checked before it is decoded.
 //   write: the encoding follows the extension and `bits` (8 or 16 for PNG/PPM/TIFF, 32 for float
 //          TIFF and EXR); integer encodings clamp to [0,1] and round.
 // Colour channels are RGB in memory (OpenCV's BGR order is undone here, once).
@@ -16,6 +17,10 @@ namespace cgsr {
 
 struct ImageReadOptions {
   int channels = 0;  // expected channel count (1, 3 or 4); 0 accepts any
+  // The size the file must declare in its header, checked before anything is decoded (a small
+  // file may declare a huge image); 0: unknown. Either way the size must be within the limits of
+  // core/image_header.h.
+  int width = 0, height = 0;
 };
 
 struct ImageWriteOptions {

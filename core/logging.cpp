@@ -1,13 +1,16 @@
 #include "core/logging.h"
 
+#include <fcntl.h>
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/sinks/dist_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-
 #include <unistd.h>
 
+#include <cerrno>
+
 #include "core/error.h"
+#include "core/io_error.h"
 
 namespace cgsr {
 namespace {
@@ -46,9 +49,16 @@ void attach_log_file(const std::filesystem::path& path) {
   auto& s = state();
   if (!s.sinks) init_logging("info");
   finish_log_file();
-  std::filesystem::create_directories(path.parent_path());
+  std::error_code ec;
+  std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) throw file_system_error(path.parent_path(), ec.value(), "create the folder");
+  // Opened here first for errno: spdlog's own failure says only "Failed opening file".
+  const std::string partial = path.string() + ".partial";
+  const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw file_system_error(partial, errno, "write the log");
+  ::close(fd);
   s.file_path = path;
-  s.file = std::make_shared<spdlog::sinks::basic_file_sink_mt>(path.string() + ".partial", /*truncate=*/true);
+  s.file = std::make_shared<spdlog::sinks::basic_file_sink_mt>(partial, /*truncate=*/true);
   s.file->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %v");
   s.sinks->add_sink(s.file);
 }

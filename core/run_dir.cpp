@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/io_error.h"
 #include "core/logging.h"
 
 namespace cgsr {
@@ -12,7 +13,7 @@ namespace cgsr {
 RunDir::RunDir(std::filesystem::path dir, bool own_log) : dir_(std::move(dir)), own_log_(own_log) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
-  if (ec) throw Error(dir_.string(), "cannot create the run directory: " + ec.message());
+  if (ec) throw file_system_error(dir_, ec.value(), "create the run directory");
   if (own_log_) attach_log_file(dir_ / "log.txt");
 }
 
@@ -25,7 +26,10 @@ void RunDir::write_config(const YAML::Node& resolved) const {
 }
 
 void RunDir::write_results(const nlohmann::ordered_json& results) const {
-  write_file_atomic(file("results.json"), results.dump(2) + "\n");
+  // Inputs are checked for UTF-8 before a command starts (core/utf8.h); a name read from disk
+  // that is not still must not cost the results at the very end, so it is replaced, not thrown.
+  write_file_atomic(file("results.json"),
+                    results.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n");
 }
 
 std::filesystem::path default_run_dir(const std::string& command) {

@@ -159,7 +159,10 @@ void write_torchscript(const std::filesystem::path& path, const graph::Graph& gr
   torch::jit::Module module = torchscript_module(graph);
   torch::jit::ExtraFilesMap extra;
   for (const auto& [name, content] : options.extra_files) extra[name] = content;
-  write_atomic_with(path, [&](const std::filesystem::path& temporary) { module.save(temporary.string(), extra); });
+  // In memory first: LibTorch's file writer throws from its destructor on a full disk.
+  std::ostringstream bytes;
+  module.save(bytes, extra);
+  write_file_atomic(path, bytes.str());
 }
 
 torch::jit::Module load_torchscript(const std::filesystem::path& path) {

@@ -25,6 +25,18 @@ for kind in color depth normal normal_angle edge id motion; do
   kind_byte=$((kind_byte + 1))
 done
 
+# A decompression bomb as a colour file: a PNG of a few hundred bytes whose header declares
+# 20000x20000 pixels (its data holds 16 rows of them); it must be refused before decoding.
+python3 - <<'PY'
+import struct, zlib
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+rows = zlib.compress((b"\0" + bytes(3 * 20000)) * 16, 9)
+png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 20000, 20000, 8, 2, 0, 0, 0)) +
+       chunk(b"IDAT", rows) + chunk(b"IEND", b""))
+open("fuzz/corpus/frame_files/color_bomb_20000x20000.bin", "wb").write(b"\0" + png)
+PY
+
 printf 'backbone: pan\nscale: 2\nblocks: 1\nwidths: {features: 8}\n' > "$work/spec.yaml"
 "$cgsr" train --data "$work/data" --model "$work/spec.yaml" --out "$work/train" --threads 1 \
   --set enhance.enabled=true --set enhance.rit.width=4 --set enhance.geometry.enabled=false \

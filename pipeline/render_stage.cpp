@@ -4,6 +4,8 @@
 
 #include "core/error.h"
 #include "core/progress.h"
+#include "core/text.h"
+#include "render_data/scene_source.h"
 
 namespace cgsr {
 
@@ -131,6 +133,24 @@ nlohmann::ordered_json run_scene_set(const RenderOptions& options, const std::fi
   return j;
 }
 }  // namespace
+
+std::string check_render(const RenderOptions& options) {
+  std::vector<SceneRenderJob> jobs;
+  if (options.scenes.empty()) {
+    jobs.push_back({options, 0, ""});
+  } else {
+    jobs = scene_set_jobs(options);
+  }
+  std::string out;
+  for (const auto& job : jobs) {
+    const std::string at = job.origin.empty() ? "" : job.origin + ": ";
+    parse_resolutions(job.options.resolutions, at + "resolutions");
+    const SceneBundle bundle = make_scene(job.options.scene, static_cast<uint64_t>(options.seed));
+    out += at + "scene '" + bundle.scene.name + "', " + std::to_string(triangle_count(bundle.scene)) + " triangles, " +
+           std::to_string(job.options.frames) + " frames at " + join(job.options.resolutions) + "\n";
+  }
+  return out;
+}
 
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out) {
   if (!options.scenes.empty()) return run_scene_set(options, out);

@@ -41,5 +41,9 @@ config::Schema<RenderOptions> render_schema();
 // The scene set's entries as render jobs, each parsed from its config file with its overrides.
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options);
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out);
+// What `cgsr render --check` does beyond the schema: the checks the run makes before its first
+// frame (resolutions, and each scene built from its block, which parses the source's options),
+// so a config --check passes is not rejected by the run. Returns a line per scene.
+std::string check_render(const RenderOptions& options);
 
 }  // namespace cgsr

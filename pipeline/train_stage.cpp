@@ -144,6 +144,7 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
                                               std::to_string(data.frames(Split::Val).size()));
     trainer.set_data_parallel(world.get());
   }
+  trainer.set_resume_force(options.force_resume);
   const TrainOutcome outcome = trainer.run(run_dir.file("checkpoint.pt"), options.resume);
   if (world && !world->coordinator()) {
     // Rank 0 writes the model files; this rank only reports its part.

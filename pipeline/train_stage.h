@@ -36,6 +36,7 @@ struct TrainOptions : RunSettings {
   TrainSchedule schedule;
   LossOptions loss;
   bool resume = false;       // continue from checkpoint.pt in --out
+  bool force_resume = false; // --force: resume despite differences (the command line's, not a config key)
   distributed::DistributedOptions distributed;  // data-parallel over processes (docs/distributed.md)
 };
 

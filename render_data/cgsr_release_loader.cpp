@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "core/error.h"
+#include "core/image_header.h"
 #include "core/image_io.h"
 #include "render_data/dataset.h"
 #include "render_data/frame_files.h"
@@ -62,11 +63,14 @@ class CgsrRelease : public FrameSource {
           if (!fs::exists(dir / name))
             throw Error((dir / name).string(), "missing (frame " + text + " exists at width " +
                                                    std::to_string(dirs.front().first) + ")");
-      const auto first = read_image(dir / ("frame" + frames_.front() + ".sim.ppm"));
-      Resolution r{static_cast<int>(first.size(2)), static_cast<int>(first.size(1))};
-      if (r.width != width)
-        throw Error((dir / ("frame" + frames_.front() + ".sim.ppm")).string(),
-                    "is " + std::to_string(r.width) + " pixels wide, but its folder says " + std::to_string(width));
+      // The size is read from the header: the folder gives the width, the height is bounded.
+      const fs::path first = dir / ("frame" + frames_.front() + ".sim.ppm");
+      const ImageHeader header = read_image_header(first);
+      if (header.width != width)
+        throw Error(first.string(),
+                    "is " + std::to_string(header.width) + " pixels wide, but its folder says " + std::to_string(width));
+      check_image_limits(header, first.string());
+      Resolution r{static_cast<int>(header.width), static_cast<int>(header.height)};
       dirs_.push_back(dir);
       info_.resolutions.push_back(r);
     }
@@ -100,7 +104,7 @@ class CgsrRelease : public FrameSource {
     if (channels.empty()) return f;
     torch::Tensor features;
     try {
-      features = read_image(feature_path, {3});
+      features = read_image(feature_path, {3, r.width, r.height});
     } catch (const Error& e) {
       throw Error(feature_path.string(), "frame " + std::to_string(frame) + ": " + e.message(), e.kind());
     }

@@ -10,6 +10,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "core/image_header.h"
 #include "core/text.h"
 
 namespace cgsr {
@@ -17,6 +18,11 @@ namespace fs = std::filesystem;
 
 Resolution parse_resolution(const std::string& text, const std::string& context) {
   const auto [w, h] = parse_size(text, context);
+  // A frame must be an image cgsr reads back (core/image_header.h); a larger one would also
+  // exhaust memory while it renders.
+  if (w > kMaxImageSide || h > kMaxImageSide || int64_t{w} * h > kMaxImagePixels)
+    throw Error(context, "resolution " + text + " is out of range: at most " + std::to_string(kMaxImageSide) +
+                             " pixels a side and " + std::to_string(kMaxImagePixels) + " pixels in all");
   return {w, h};
 }
 

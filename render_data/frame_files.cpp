@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/image_header.h"
 #include "core/image_io.h"
 #include "core/tensor_checks.h"
 
@@ -103,7 +104,13 @@ DecodedFile decode_file(FileKind kind, const fs::path& path, int frame, const Re
   const int channels = kind == FileKind::Color || kind == FileKind::Normal || kind == FileKind::Id || kind == FileKind::Motion ? 3 : 1;
   torch::Tensor v;
   try {
-    v = read_image(path, {channels});
+    // The size its header declares first: a small file may declare a huge image.
+    const ImageHeader header = read_image_header(path);
+    if (header.width != expected.width || header.height != expected.height)
+      return fail(FileProblem::WrongSize, "size " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                                              " (from the " + header.format + " header; not decoded) does not match "
+                                              "the resolution " + expected.name());
+    v = read_image(path, {channels, expected.width, expected.height});
   } catch (const Error& e) {
     return fail(FileProblem::Unreadable, e.message());
   }

@@ -93,7 +93,9 @@ std::vector<fs::path> glob_files(const fs::path& base, const std::string& patter
   const fs::path full = base / pattern;
   const fs::path dir = full.parent_path();
   const std::string name = full.filename().string();
-  if (dir.string().find_first_of("*?") != std::string::npos)
+  // Only the pattern's own folders are read as wildcards: the capture's folder may be named
+  // anything, '*' included.
+  if (fs::path(pattern).parent_path().string().find_first_of("*?") != std::string::npos)
     throw Error(pattern, "wildcards are only supported in the file name, not in folders");
   if (!fs::is_directory(dir)) throw Error(pattern, "no such folder " + dir.string());
   std::vector<fs::path> out;
@@ -190,7 +192,7 @@ class GlobDataset : public FrameSource {
     // Reads one file, checked for size and NaN/Inf, and decodes it; errors name file and frame.
     auto decode = [&](const fs::path& p, const char* what, auto&& decoder) {
       try {
-        const ImageFile image = read_image_file(p);
+        const ImageFile image = read_image_file(p, {0, r.width, r.height});
         check_image_size(image.pixels, r, p.string(), frame);
         check_finite(image.pixels, p.string(), frame, what);
         return decoder(image);
@@ -257,10 +259,13 @@ bool looks_like_glob_layout(const fs::path& path) {
   const auto ext = yaml.extension().string();
   if (ext != ".yaml" && ext != ".yml") return false;
   try {
-    const YAML::Node n = YAML::LoadFile(yaml.string());
+    const YAML::Node n = config::Document::load_file(yaml).root();
     return n.IsMap() && n["layout"] && n["layout"].IsScalar() && n["layout"].Scalar() == "glob";
-  } catch (const YAML::Exception&) {
-    return false;
+  } catch (const Error&) {
+    // A YAML file that does not load (a syntax error, a duplicate key, too large) can only be
+    // meant as a capture: opening it reports the error with its line and column, not "not a
+    // dataset".
+    return true;
   }
 }
 

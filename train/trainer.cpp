@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/enum_names.h"
@@ -11,8 +12,11 @@
 #include "core/error.h"
 #include "core/metrics.h"
 #include "core/progress.h"
+#include "core/runtime.h"
+#include "core/text.h"
 #include "models/arch_spec.h"
 #include "render_data/patch_sampler.h"
+#include "train/run_identity.h"
 
 namespace cgsr {
 
@@ -71,6 +75,7 @@ nlohmann::ordered_json to_json(const TrainOutcome& o) {
   j["seconds"] = o.seconds;
   j["patches_per_second"] = o.patches_per_second;
   j["resumed"] = o.resumed;
+  if (!o.resume_overrides.empty()) j["resume_overrides"] = o.resume_overrides;
   j["layout"] = enum_name(o.layout);
   j["phase_ms"] = o.phase_ms;
   j["best"] = score(o.best);
@@ -241,6 +246,10 @@ ValidationScore Trainer::validate(int step) {
   return score;
 }
 
+RunIdentity Trainer::identity() const {
+  return run_identity(global_seed(), schedule_, data_.info(), network_->spec());
+}
+
 void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome) {
   torch::serialize::OutputArchive archive;
   torch::serialize::OutputArchive model, optimizer, best;
@@ -261,7 +270,12 @@ void Trainer::save_checkpoint(const std::filesystem::path& path, int step, const
   archive.write("outcome", text_tensor(state.dump()));
   archive.write("torch_rng", at::detail::getDefaultCPUGenerator().get_state());
   archive.write("layout", text_tensor(enum_name(layout_)));
-  write_atomic_with(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
+  archive.write("identity", text_tensor(nlohmann::json(identity()).dump()));
+  // Serialized in memory: LibTorch's file writer throws from its destructor on a full disk, which
+  // ends the process; the atomic writer reports it and keeps the last good checkpoint.
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  write_file_atomic(path, bytes.str());
 }
 
 bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, TrainOutcome& outcome) {
@@ -273,6 +287,17 @@ bool Trainer::load_checkpoint(const std::filesystem::path& path, int& step, Trai
     archive.read("spec", spec);
     if (tensor_text(spec) != spec_to_yaml(network_->spec()))
       throw Error(path.string(), "the checkpoint was written for a different architecture:\n" + tensor_text(spec));
+    torch::Tensor identity_t;
+    if (archive.try_read("identity", identity_t)) {  // checkpoints of older versions have none
+      const auto differences =
+          identity_differences(nlohmann::json::parse(tensor_text(identity_t)).get<RunIdentity>(), identity());
+      if (!differences.empty() && !resume_force_)
+        throw Error(path.string(), "was written by a different run, so resuming would mix two:\n  " +
+                                       join(differences, "\n  ") +
+                                       "\nchoose another --out to start afresh, or pass --force to go on anyway");
+      for (const auto& d : differences) spdlog::warn("{}: resuming despite a difference (--force): {}", path.string(), d);
+      outcome.resume_overrides = differences;
+    }
     archive.read("model", model);
     network_->load(model);
     if (!hooks_.extra_parameters.empty()) {

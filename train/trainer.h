@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -77,6 +78,8 @@ struct TrainOutcome {
   std::vector<ValidationScore> history;
   std::vector<double> loss_curve;  // training loss (the CGSR total) of every step, over the global batch
   bool resumed = false;
+  // --resume --force: how the checkpoint's run differed from this one (train/run_identity.h).
+  std::vector<std::string> resume_overrides;
   MemoryLayout layout = MemoryLayout::Nchw;  // the memory layout the steps ran in
   StepPhases phase_ms;  // over the steps this run took (a resumed run: since the resume)
 };
@@ -118,6 +121,10 @@ class Trainer {
   // checkpoint; a resume hands rank 0's checkpoint to every rank.
   void set_data_parallel(distributed::World* world) { world_ = world; }
 
+  // A resume from a checkpoint of a different run (seed, schedule, data set: run_identity.h) is a
+  // user error listing the differences; forced, it goes on and records them in the outcome.
+  void set_resume_force(bool force) { resume_force_ = force; }
+
   // Writes the weights of the final step (the network itself holds the best ones after run()).
   void save_last_model(const std::filesystem::path& path, const Provenance& provenance) const;
 
@@ -128,6 +135,7 @@ class Trainer {
   TrainOutput forward(const Batch& batch, int step);
   std::vector<torch::Tensor> tracked() const;  // the network's parameters, then the hooks' extras
   void save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome);
+  std::map<std::string, std::string> identity() const;  // run_identity.h
   bool load_checkpoint(const std::filesystem::path& path, int& step, TrainOutcome& outcome);
 
   SRNetwork network_;
@@ -142,6 +150,7 @@ class Trainer {
   std::unique_ptr<torch::optim::Adam> optimizer_;
   std::vector<torch::Tensor> best_weights_, last_weights_;
   distributed::World* world_ = nullptr;
+  bool resume_force_ = false;
 };
 
 }  // namespace cgsr

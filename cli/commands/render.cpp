@@ -24,7 +24,7 @@ void setup_render(CLI::App& app) {
       [](const RenderOptions& options, const YAML::Node&, RunDir* run_dir) {
         return run_render(options, run_dir->path());
       },
-      /*always_run_dir=*/true);
+      /*always_run_dir=*/true, /*place_run_dir=*/{}, check_render);
 }
 
 }  // namespace cgsr::cli

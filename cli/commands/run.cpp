@@ -29,8 +29,10 @@ void setup_run(CLI::App& app) {
       },
       [](const PipelineOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
         const fs::path dir = run_root(options);
+        std::unique_ptr<RunDirLock> lock;
         std::unique_ptr<RunDir> own;
         if (!run_dir) {
+          lock = std::make_unique<RunDirLock>(dir, "run", globals().force);
           own = std::make_unique<RunDir>(dir);
           own->write_config(resolved);
         }

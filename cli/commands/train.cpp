@@ -17,7 +17,9 @@ void setup_train(CLI::App& app) {
         add_distributed_flags(sub, flags);
       },
       [](const TrainOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
-        return run_train(options, resolved, *run_dir);
+        TrainOptions forced = options;
+        forced.force_resume = globals().force;
+        return run_train(forced, resolved, *run_dir);
       },
       /*always_run_dir=*/true,
       [](const TrainOptions& options, const std::filesystem::path& out) {

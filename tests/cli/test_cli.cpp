@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "tests/support/child_process.h"
 #include "tests/support/cli_runner.h"
 
 using cgsr::test::run_cgsr;
@@ -64,7 +65,7 @@ TEST(Cli, WrongTypeAndOutOfRangeAreUserErrors) {
   EXPECT_NE(r.err.find("--set seed=abc: seed: expected an integer, got 'abc'"), std::string::npos) << r.err;
   r = run_cgsr("info --set threads=5000");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("threads: must be in [0, 1024]"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("threads: '5000' is out of range [0, 1024]"), std::string::npos) << r.err;
   r = run_cgsr("info --set threads=-1");
   EXPECT_EQ(r.exit_code, 2);
 }
@@ -90,4 +91,97 @@ TEST(Cli, AListAsAKeyInAStageSectionIsAUserErrorAtItsLine) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(file.string() + ":4:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("a key must be a name"), std::string::npos) << r.err;
+}
+
+// One writer per run directory: while one command holds a directory, a second one exits 2
+// naming the holder's PID (it used to write into it too, both exiting 0 with a mixed result).
+TEST(Cli, ASecondCommandOnARunDirectoryInUseExitsTwoNamingTheHolder) {
+  const auto dir = scratch_dir("cli-lock");
+  const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
+  cgsr::test::CgsrProcess first(
+      {"render", "--config", tiny, "--set", "frames=400", "--threads", "1", "--out", (dir / "data").string()},
+      dir / "first");
+  const std::string holder = std::to_string(first.pid()) + " render";
+  ASSERT_TRUE(first.wait_for([&] { return cgsr::test::slurp(dir / "data" / ".cgsr.lock").rfind(holder, 0) == 0; },
+                             std::chrono::seconds(60)))
+      << cgsr::test::slurp(dir / "first.err");
+  const auto second = run_cgsr("render --config " + tiny + " --set frames=400 --out " + (dir / "data").string());
+  first.kill();
+  EXPECT_EQ(second.exit_code, 2) << second.err;
+  EXPECT_NE(second.err.find((dir / "data").string() + ": is in use by another command ('cgsr render', pid " +
+                            std::to_string(first.pid()) + ")"),
+            std::string::npos)
+      << second.err;
+}
+
+// A directory that belongs to another command is refused unless --force; the lock dies with its
+// holder, so the directory is free again once that ends.
+TEST(Cli, ARunDirectoryOfAnotherCommandIsRefusedUnlessForced) {
+  const auto dir = scratch_dir("cli-kind") / "run";
+  ASSERT_EQ(run_cgsr("info --out " + dir.string()).exit_code, 0);
+  ASSERT_EQ(run_cgsr("info --out " + dir.string()).exit_code, 0);  // the same command may rerun
+  const std::string render =
+      "render --config " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --set frames=1 --out " + dir.string();
+  auto r = run_cgsr(render);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(dir.string() + ": belongs to 'cgsr info' (.cgsr.lock); choose another --out, or pass --force"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(cgsr::read_file(dir / "config.yaml").find("scene"), std::string::npos);  // info's config is untouched
+  r = run_cgsr(render + " --force");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(cgsr::read_file(dir / ".cgsr.lock").find(" render"), std::string::npos);
+}
+
+// A non-UTF-8 --out used to pass every check and fail at the very end (exit 1, json type_error
+// 316, no results.json); now it is refused before the directory is made.
+TEST(Cli, ANonUtf8OutPathIsRefusedBeforeAnyWork) {
+  const auto dir = scratch_dir("cli-utf8");
+  const std::string bad = (dir / "caf\xE9").string();
+  auto r = run_cgsr("info --out '" + bad + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("error: --out: the path is not valid UTF-8 (byte 0xE9"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+  r = run_cgsr("info --set \"name=caf\xE9\" --out " + (dir / "ok").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("not valid UTF-8 (byte 0xE9)"), std::string::npos) << r.err;
+}
+
+// A read-only --out was an internal error (exit 1, "Failed opening .../log.txt.partial"); it is
+// the user's to fix: exit 2 naming the directory and what to do. Needs a read-only mount (root).
+TEST(Cli, AReadOnlyOutExitsTwoNamingTheFix) {
+  const auto dir = scratch_dir("cli-read-only");
+  const std::string mount = "mount -t tmpfs -o ro,size=1M tmpfs " + dir.string() + " 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0) GTEST_SKIP() << "cannot mount a read-only tmpfs here";
+  const auto r = run_cgsr("info --out " + (dir / "run").string());
+  std::system(("umount " + dir.string()).c_str());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("the file system is read-only; choose another --out"), std::string::npos) << r.err;
+}
+
+// Memory for the sizes asked for is the machine's limit, not a bug: exit 2 with the fix, and no
+// LibTorch backtrace (it printed 40 frames).
+TEST(Cli, OutOfMemoryForTheRequestedSizeExitsTwoWithoutABacktrace) {
+  const auto r = run_cgsr("bench --model pan --input 16000x16000 --batch 64 --runs 1 --warmup 0 --threads 1");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("error: out of memory: the sizes asked for"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("frame #"), std::string::npos) << r.err;
+}
+
+// --check makes the checks the run makes: a render resolution beyond what cgsr reads back, and a
+// scene option out of range (scene.size=[100000,100000] used to pass --check and fail the run).
+TEST(Cli, RenderCheckAppliesTheRunsRangeChecks) {
+  const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
+  auto r = run_cgsr("render --config " + tiny + " --check");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("triangles, 6 frames at 64x48, 128x96"), std::string::npos) << r.out;
+  r = run_cgsr("render --config " + tiny + " --set scene.size=[100000,100000] --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--set scene.size=[100000,100000]: scene.size[0]: '100000' is out of range [3, 200]"),
+            std::string::npos)
+      << r.err;
+  r = run_cgsr("render --config " + tiny + " --set resolutions=[20000x15000,40000x30000] --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("resolution 20000x15000 is out of range: at most 16384 pixels a side"), std::string::npos)
+      << r.err;
 }

@@ -4,6 +4,8 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "core/config.h"
@@ -114,9 +116,9 @@ TEST(Config, WrongTypeOutOfRangeAndMissingKeys) {
   auto e = error_of("name: hall\nframes: many\n");
   EXPECT_NE(e.find("scene.yaml:2:9: frames: expected an integer, got 'many'"), std::string::npos) << e;
   e = error_of("name: hall\nframes: 0\n");
-  EXPECT_NE(e.find("frames: must be in [1, 100000]"), std::string::npos) << e;
+  EXPECT_NE(e.find("frames: '0' is out of range [1, 100000]"), std::string::npos) << e;
   e = error_of("name: hall\ncamera: {fov: 500}\n");
-  EXPECT_NE(e.find("camera.fov: must be in [1, 179]"), std::string::npos) << e;
+  EXPECT_NE(e.find("camera.fov: '500' is out of range [1, 179]"), std::string::npos) << e;
   e = error_of("frames: 3\n");
   EXPECT_NE(e.find("missing required key 'name'"), std::string::npos) << e;
   e = error_of("name: hall\nlights: [{kind: spot}]\n");
@@ -153,6 +155,47 @@ TEST(Config, OverrideErrorsNameTheAssignment) {
   EXPECT_NE(e.find("did you mean 'frames'"), std::string::npos) << e;
   EXPECT_THROW(parse("name: hall\n", {"frames"}), Error);
   EXPECT_THROW(parse("name: hall\n", {"name.inner=3"}), Error);  // name is a scalar
+}
+
+// An unknown section made by --set (`open.derive=[edge]` where there is no `open`) is located at
+// the assignment; it used to be reported at "<defaults>".
+TEST(Config, AnUnknownSectionFromSetNamesTheAssignment) {
+  const auto e = error_of("name: hall\n", {"open.derive=[edge]"});
+  EXPECT_EQ(e.find("<defaults>"), std::string::npos) << e;
+  EXPECT_NE(e.find("--set open.derive=[edge]: open: unknown key 'open'"), std::string::npos) << e;
+}
+
+// A whole number too large for the field is out of range, not "expected an integer"; whole
+// numbers written with an exponent are integers.
+TEST(Config, LargeNumbersAreOutOfRangeNotOfAWrongType) {
+  auto e = error_of("name: hall\n", {"frames=1e15"});
+  EXPECT_NE(e.find("--set frames=1e15: frames: '1e15' is out of range [1, 100000]"), std::string::npos) << e;
+  e = error_of("name: hall\nframes: 99999999999999999999\n");
+  EXPECT_NE(e.find("scene.yaml:2:9: frames: '99999999999999999999' is out of range [1, 100000]"), std::string::npos)
+      << e;
+  e = error_of("name: hall\nframes: 2.5\n");
+  EXPECT_NE(e.find("frames: expected an integer, got '2.5'"), std::string::npos) << e;
+  EXPECT_EQ(parse("name: hall\nframes: 1e3\n").frames, 1000);
+  // An element of a list given by --set is located at the assignment, not in the file.
+  e = error_of("name: hall\nlights: [{}]\n", {"lights=[{intensity: -2}]"});
+  EXPECT_NE(e.find("--set lights=[{intensity: -2}]: lights[0].intensity: '-2' is out of range [0, inf)"),
+            std::string::npos)
+      << e;
+  e = error_of("name: hall\nlights: [{intensity: -1}]\n");
+  EXPECT_NE(e.find("lights[0].intensity: '-1' is out of range [0, inf)"), std::string::npos) << e;
+  // A field without a range still names its type's bounds.
+  struct Wide {
+    int small = 0;
+  };
+  Schema<Wide> schema;
+  schema.field("small", &Wide::small, "an int");
+  try {
+    parse_document(Document::parse("small: 1e12\n", "w.yaml"), schema);
+    FAIL();
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("small: '1e12' is out of range [-2147483648, 2147483647]"), std::string::npos)
+        << err.what();
+  }
 }
 
 TEST(Config, TypedBlocksKeepTheirLocation) {
@@ -249,7 +292,7 @@ TEST(Config, AnInlineSectionReadsAtTheTopAndItsFormerBlockStillReads) {
     parse_document(Document::parse("camera: {fov: 300}\n", "job.yaml"), job_schema());
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("job.yaml:1:15: fov: must be in [1, 179]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("job.yaml:1:15: fov: '300' is out of range [1, 179]"), std::string::npos) << e.what();
   }
   try {
     parse_document(Document::parse("fov: 30\ncamera: {fov: 40}\n", "job.yaml"), job_schema());
@@ -300,7 +343,7 @@ TEST(Config, AnInlineSectionCarriesItsSchemasUpgrades) {
     parse_document(Document::parse("angle: 300\n", "new-job.yaml"), schema);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("new-job.yaml:1:8: fov: must be in [1, 179]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("new-job.yaml:1:8: fov: '300' is out of range [1, 179]"), std::string::npos) << e.what();
   }
 }
 
@@ -312,4 +355,54 @@ TEST(Config, AKeyThatIsAListReachesJsonAsItsYamlText) {
   EXPECT_EQ(j["train"]["[a, b]"], 1);
   EXPECT_EQ(j["train"]["~"], 2);
   EXPECT_EQ(j["train"]["steps"], 3);
+}
+
+// Duplicate keys were accepted silently (yaml-cpp reads the first); now an error naming both lines.
+TEST(Config, DuplicateKeysAreAnErrorNamingBothLines) {
+  auto e = error_of("name: hall\nframes: 3\ncamera: {fov: 70}\nframes: 4\n");
+  EXPECT_NE(e.find("scene.yaml:4:1: duplicate key 'frames' (first at line 2); keep one"), std::string::npos) << e;
+  e = error_of("name: hall\ncamera:\n  fov: 70\n  fov: 80\n");
+  EXPECT_NE(e.find("scene.yaml:4:3: duplicate key 'fov' (first at line 3)"), std::string::npos) << e;
+  e = error_of("name: hall\n", {"camera={fov: 1, fov: 2}"});
+  EXPECT_NE(e.find("duplicate key 'fov'"), std::string::npos) << e;
+}
+
+// A 10 MB list took 1.68 GB and --check called it valid; 50 MB died with std::bad_alloc. The size
+// is checked before yaml-cpp reads the text, lists and values right after, before any schema.
+TEST(Config, ConfigsAreBoundedBeforeTheyAreParsed) {
+  std::string big = "name: hall\nlights: [";
+  while (big.size() <= (size_t{1} << 20)) big += "{}, ";
+  big += "{}]\n";
+  auto e = error_of(big);
+  EXPECT_NE(e.find("scene.yaml: the config is " + std::to_string(big.size()) +
+                   " bytes, more than the limit of 1048576 (1 MiB)"),
+            std::string::npos)
+      << e.substr(0, 300);
+  std::string list = "name: hall\ncamera: {position: [";
+  for (int i = 0; i < 100001; ++i) list += "0,";
+  list += "0]}\n";
+  e = error_of(list);
+  EXPECT_NE(e.find("scene.yaml:2:"), std::string::npos) << e.substr(0, 300);
+  EXPECT_NE(e.find("a list of 100002 items, more than the limit of 100000"), std::string::npos)
+      << e.substr(0, 300);
+  // Aliases reuse a node without copying it: counted as often as they are used.
+  std::string laughs = "l0: &l0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+  for (int level = 1; level <= 7; ++level) {  // 10^8 values from a few hundred bytes
+    const std::string previous = "*l" + std::to_string(level - 1);
+    laughs += "l" + std::to_string(level) + ": &l" + std::to_string(level) + " [" + previous;
+    for (int i = 1; i < 10; ++i) laughs += ", " + previous;
+    laughs += "]\n";
+  }
+  e = error_of(laughs);
+  EXPECT_NE(e.find("more than 1000000 values (counting each use of an alias)"), std::string::npos) << e;
+  // A file too large is refused before it is read.
+  const auto file = std::filesystem::temp_directory_path() / ("cgsr-big-config-" + std::to_string(::getpid()) + ".yaml");
+  { std::ofstream(file) << big; }
+  try {
+    Document::load_file(file);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("more than the limit of 1048576"), std::string::npos) << err.what();
+  }
+  std::filesystem::remove(file);
 }

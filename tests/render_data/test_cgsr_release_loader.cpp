@@ -147,5 +147,34 @@ TEST(CgsrReleaseLoader, NonIntegerScaleIsRejected) {
   }
 }
 
+// The size of a width folder comes from its first colour file's header, never from decoding it:
+// a PPM that declares 64x100000 is refused, and so is a feature file declaring another size.
+TEST(CgsrReleaseLoader, HeadersDeclaringHugeOrWrongSizesAreRefusedBeforeDecoding) {
+  const fs::path root = write_release("release_bomb", 2);
+  const fs::path first = root / "64" / "frame000.sim.ppm";
+  std::ofstream(first, std::ios::binary | std::ios::trunc) << "P6\n64 100000\n255\n" << std::string(64 * 3, '\0');
+  try {
+    Dataset::open(root);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(first.string() + ": the PNM header declares 64x100000 pixels, beyond the limit"),
+              std::string::npos)
+        << e.what();
+  }
+  write_release_frame(root / "64", 0, 64, true);
+  const fs::path feature = root / "64" / "feature001.bmp";
+  write_image(feature, torch::rand({3, 480, 640}));
+  const Dataset data = Dataset::open(root);
+  try {
+    data.frame(1, 0);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(feature.string() + ": frame 1: size 640x480 (from the BMP header; not "
+                                                              "decoded) does not match the resolution 64x48"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace cgsr

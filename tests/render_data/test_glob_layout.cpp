@@ -116,5 +116,59 @@ TEST(GlobLayout, RgbaColourLoadsAndHdrColourIsRejectedByFileAndFrame) {
   }
 }
 
+// A '*' in the capture's own folder name is a name, not a wildcard (it used to be refused).
+TEST(GlobLayout, ACaptureFolderNamedWithAStarLoads) {
+  const fs::path root = write_capture("glob_star*[1]", 2);
+  EXPECT_EQ(Dataset::open(root).frame_count(), 2);
+  // A wildcard in the pattern's own folders is still refused.
+  std::ofstream(root / "dataset.yaml") << "layout: glob\nresolutions:\n  - size: 32x24\n    color: l*/color_*.png\n";
+  try {
+    Dataset::open(root);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("l*/color_*.png: wildcards are only supported in the file name"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A capture description with a YAML syntax error says where, not "not a dataset in any layout".
+TEST(GlobLayout, ASyntaxErrorInTheCaptureYamlNamesItsLine) {
+  const fs::path root = write_capture("glob_syntax", 1);
+  std::ofstream(root / "dataset.yaml") << "layout: glob\nresolutions:\n  - size: [32x24\n    color: lr/color_*.png\n";
+  try {
+    Dataset::open(root);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.kind(), ErrorKind::User);
+    EXPECT_EQ(what.find("not a dataset"), std::string::npos) << what;
+    EXPECT_NE(what.find((root / "dataset.yaml").string() + ":"), std::string::npos) << what;
+    EXPECT_NE(what.find("invalid YAML"), std::string::npos) << what;
+  }
+}
+
+// A capture frame whose header declares far more pixels than its resolution is refused before it
+// is decoded, naming the file and the frame (fuzz/corpus's bomb seed: 1 KB, 20000x20000).
+TEST(GlobLayout, ADecompressionBombFrameIsRefusedNamingTheFile) {
+  const fs::path root = write_capture("glob_bomb", 2);
+  std::ifstream in(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/frame_files/color_bomb_20000x20000.bin",
+                   std::ios::binary);
+  in.get();  // the seed's file-kind byte
+  std::ofstream(root / "hr" / "frame1.png", std::ios::binary | std::ios::trunc) << in.rdbuf();
+  const Dataset data = Dataset::open(root);
+  try {
+    data.frame(1, 1);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::User);
+    EXPECT_NE(std::string(e.what()).find((root / "hr" / "frame1.png").string() +
+                                         ": frame 1: size 20000x20000 (from the PNG header; not decoded) does "
+                                         "not match the resolution 64x48"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace cgsr

@@ -16,6 +16,15 @@ namespace fs = std::filesystem;
 using test::CliResult;
 using test::run_cgsr;
 
+// fuzz/corpus's bomb seed without its file-kind byte.
+fs::path bomb_png() {
+  const fs::path path = test::temp_dir("bomb") / "bomb.png";
+  std::ifstream in(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/frame_files/color_bomb_20000x20000.bin", std::ios::binary);
+  in.get();
+  std::ofstream(path, std::ios::binary) << in.rdbuf();
+  return path;
+}
+
 std::string tiny_config() { return std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml"; }
 
 TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
@@ -48,7 +57,14 @@ TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
   // Damage: a corrupt depth file and a missing edge file are counted, named, and exit code 2.
   std::ofstream(out / "64x48" / "depth" / "000003.exr", std::ios::trunc) << "not an exr";
   fs::remove(out / "128x96" / "edge" / "000001.png");
+  // A decompression bomb as a colour frame (1 KB declaring 20000x20000): named, never decoded.
+  fs::copy_file(bomb_png(), out / "64x48" / "color" / "000004.png", fs::copy_options::overwrite_existing);
   const CliResult damaged = run_cgsr("data check " + out.string());
+  EXPECT_NE(damaged.all().find("64x48/color/000004.png: frame 4: size 20000x20000 (from the PNG header; not decoded) "
+                               "does not match the resolution 64x48"),
+            std::string::npos)
+      << damaged.all();
+  EXPECT_NE(damaged.all().find("wrong size             1"), std::string::npos) << damaged.all();
   EXPECT_EQ(damaged.exit_code, 2) << damaged.all();
   EXPECT_NE(damaged.all().find("64x48/depth/000003.exr: frame 3"), std::string::npos) << damaged.all();
   EXPECT_NE(damaged.all().find("128x96/edge/000001.png: frame 1: missing file"), std::string::npos) << damaged.all();

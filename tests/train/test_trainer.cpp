@@ -13,6 +13,7 @@
 #include "core/runtime.h"
 #include "models/arch_spec.h"
 #include "tests/support/tiny_data.h"
+#include "train/run_identity.h"
 #include "train/trainer.h"
 
 using namespace cgsr;
@@ -351,4 +352,98 @@ TEST(Trainer, PhaseTimesKeepTheirJsonFormat) {
   EXPECT_EQ(to_json(o)["phase_ms"].dump(), R"({"batch":1.5,"forward_and_loss":2.5,"backward_and_clip":3.5,)"
                                            R"("optimizer":0.25,"validation":0.0,"checkpoint":0.125})");
   EXPECT_EQ(to_json(o)["layout"], "nchw");
+}
+
+namespace {
+std::string train_command(const std::filesystem::path& out) {
+  return "train --data " + tiny_data().string() +
+         " --model pan --threads 1 --set schedule.steps=4 --set schedule.checkpoint_every=2"
+         " --set schedule.batch_size=2 --set schedule.patch_size=16 --set schedule.val_frames=1 --out " +
+         out.string();
+}
+
+size_t temporaries_in(const std::filesystem::path& dir) {
+  size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
+  return n;
+}
+}  // namespace
+
+// A full disk at a checkpoint used to end the process (SIGABRT from LibTorch's archive writer)
+// and leave checkpoint.pt.tmp-PID behind. Now: exit 2 naming the file and the fix, no temporary
+// left, the last good checkpoint kept, and --resume goes on from it.
+TEST(TrainCommand, AFullDiskAtACheckpointExitsTwoAndResumeGoesOnFromTheLastGoodOne) {
+  const auto out = scratch_dir("train-full-disk") / "run";
+  ::setenv("CGSR_FAULT_NO_SPACE", "checkpoint.pt@1", 1);  // the step-2 checkpoint is written, step 4's is not
+  auto r = run_cgsr(train_command(out));
+  ::unsetenv("CGSR_FAULT_NO_SPACE");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find((out / "checkpoint.pt").string() + ": cannot write: no space left on the device"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("terminate called"), std::string::npos) << r.err;
+  EXPECT_EQ(temporaries_in(out), 0u);
+  ASSERT_TRUE(std::filesystem::exists(out / "checkpoint.pt"));
+  EXPECT_FALSE(std::filesystem::exists(out / "results.json"));
+
+  r = run_cgsr(train_command(out) + " --resume");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("at step 2/4"), std::string::npos) << r.err;
+  EXPECT_TRUE(read_json(out / "results.json")["training"]["resumed"].get<bool>());
+}
+
+// The same on a real full file system, where the machine allows mounting one (root).
+TEST(TrainCommand, ACheckpointOnASmallTmpfsExitsTwoAndLeavesNoTemporary) {
+  const auto mount_point = scratch_dir("train-tmpfs");
+  const std::string mount = "mount -t tmpfs -o size=3M tmpfs " + mount_point.string() + " 2>/dev/null";
+  if (::geteuid() != 0 || std::system(mount.c_str()) != 0) GTEST_SKIP() << "cannot mount a tmpfs here";
+  const auto r = run_cgsr(train_command(mount_point / "tr"));
+  const size_t left = temporaries_in(mount_point / "tr");
+  std::system(("umount " + mount_point.string()).c_str());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("no space left on the device"), std::string::npos) << r.err;
+  EXPECT_EQ(left, 0u);
+}
+
+// --resume with another seed, batch size or data set was accepted silently; now the differences
+// are listed and the run exits 2, unless --force, which goes on and records them. A longer
+// schedule is not a difference: that is what resuming is for.
+TEST(TrainCommand, ResumingWithAnotherSeedOrScheduleExitsTwoListingTheDifferences) {
+  const auto out = scratch_dir("train-resume-identity") / "run";
+  auto r = run_cgsr(train_command(out) + " --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cgsr(train_command(out) + " --seed 4 --set schedule.batch_size=4 --set schedule.steps=6 --resume");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find((out / "checkpoint.pt").string() + ": was written by a different run"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("  seed: 3 in the checkpoint, 4 now"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("  schedule.batch_size: 2 in the checkpoint, 4 now"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("schedule.steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pass --force"), std::string::npos) << r.err;
+
+  r = run_cgsr(train_command(out) + " --seed 3 --set schedule.steps=6 --resume");  // only longer: fine
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(read_json(out / "results.json")["training"].contains("resume_overrides"));
+
+  r = run_cgsr(train_command(out) + " --seed 4 --set schedule.steps=8 --resume --force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto overrides = read_json(out / "results.json")["training"]["resume_overrides"];
+  ASSERT_EQ(overrides.size(), 1u) << overrides.dump();
+  EXPECT_EQ(overrides[0], "seed: 3 in the checkpoint, 4 now");
+}
+
+// The data set's fingerprint: another data set (or the same one with other frames) differs.
+TEST(RunIdentity, TheDataSetFingerprintTellsDataSetsApart) {
+  const Dataset data = Dataset::open(tiny_data());
+  const ArchSpec spec = small_pan();
+  const TrainSchedule schedule = short_schedule(MemoryLayout::Nchw);
+  const RunIdentity now = run_identity(3, schedule, data.info(), spec);
+  EXPECT_TRUE(identity_differences(now, now).empty());
+  DatasetInfo other = data.info();
+  other.frames += 1;
+  other.name = "other";
+  const auto differences = identity_differences(run_identity(3, schedule, other, spec), now);
+  ASSERT_EQ(differences.size(), 1u);
+  EXPECT_EQ(differences[0].rfind("data: cgsr 'other', 7 frames", 0), 0u) << differences[0];
 }

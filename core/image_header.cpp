@@ -1,0 +1,196 @@
+#include "core/image_header.h"
+
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace cgsr {
+namespace {
+
+const char* const kCutShort = "the image header is cut short";
+
+// Bounds-checked reads of the header bytes; a read past the end is a truncated header.
+class Bytes {
+ public:
+  Bytes(const std::string& data, const std::string& context) : data_(data), context_(context) {}
+  size_t size() const { return data_.size(); }
+  uint8_t u8(size_t at) const {
+    need(at, 1);
+    return static_cast<uint8_t>(data_[at]);
+  }
+  uint32_t be(size_t at, int n) const {
+    need(at, n);
+    uint32_t v = 0;
+    for (int i = 0; i < n; ++i) v = (v << 8) | u8(at + i);
+    return v;
+  }
+  uint32_t le(size_t at, int n) const {
+    need(at, n);
+    uint32_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = (v << 8) | u8(at + i);
+    return v;
+  }
+  bool starts_with(const std::string& magic) const { return data_.compare(0, magic.size(), magic) == 0; }
+  [[noreturn]] void fail(const std::string& what) const { throw Error(context_, "unreadable image: " + what); }
+  void need(size_t at, size_t n) const {
+    if (at > data_.size() || n > data_.size() - at) fail(kCutShort);
+  }
+  const std::string& data() const { return data_; }
+
+ private:
+  const std::string& data_;
+  std::string context_;
+};
+
+ImageHeader png(const Bytes& b) {
+  // Signature, then the IHDR chunk: length, "IHDR", width, height (big-endian).
+  b.need(12, 4);
+  if (b.data().compare(12, 4, "IHDR") != 0) b.fail("a PNG file whose first chunk is not IHDR");
+  return {"PNG", b.be(16, 4), b.be(20, 4)};
+}
+
+ImageHeader jpeg(const Bytes& b) {
+  size_t at = 2;
+  while (true) {
+    if (b.u8(at) != 0xFF) b.fail("a JPEG file with a broken marker at byte " + std::to_string(at));
+    while (b.u8(at) == 0xFF) ++at;  // fill bytes
+    const uint8_t marker = b.u8(at++);
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // no length
+    if (marker == 0xD9 || marker == 0xDA) b.fail("a JPEG file without a frame header before its image data");
+    const uint32_t length = b.be(at, 2);
+    if (length < 2) b.fail("a JPEG file with a segment of length " + std::to_string(length));
+    // Start of frame: every SOFn but DHT (C4), JPG (C8) and DAC (CC).
+    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+      return {"JPEG", b.be(at + 5, 2), b.be(at + 3, 2)};
+    at += length;
+  }
+}
+
+ImageHeader pnm(const Bytes& b) {
+  // "P5 <width> <height> ...", whitespace and '#' comments between the fields.
+  size_t at = 2;
+  const auto number = [&]() -> int64_t {
+    while (true) {
+      const char c = static_cast<char>(b.u8(at));
+      if (c == '#') {
+        while (b.u8(at) != '\n') ++at;
+      } else if (std::isspace(static_cast<unsigned char>(c))) {
+        ++at;
+      } else {
+        break;
+      }
+    }
+    if (!std::isdigit(b.u8(at))) b.fail("a PPM/PGM header without its width and height");
+    int64_t v = 0;
+    while (std::isdigit(b.u8(at))) {
+      v = v * 10 + (b.u8(at++) - '0');
+      if (v > (int64_t{1} << 31)) b.fail("a PPM/PGM header declaring a size beyond 2^31");
+    }
+    return v;
+  };
+  const int64_t width = number();
+  return {"PNM", width, number()};
+}
+
+ImageHeader bmp(const Bytes& b) {
+  const uint32_t info_size = b.le(14, 4);
+  if (info_size == 12) return {"BMP", b.le(18, 2), b.le(20, 2)};  // OS/2 core header
+  const int64_t width = static_cast<int32_t>(b.le(18, 4));
+  const int64_t height = static_cast<int32_t>(b.le(22, 4));  // negative: stored top-down
+  return {"BMP", width < 0 ? -width : width, height < 0 ? -height : height};
+}
+
+ImageHeader tiff(const Bytes& b) {
+  const bool little = b.u8(0) == 'I';
+  const auto read = [&](size_t at, int n) { return little ? b.le(at, n) : b.be(at, n); };
+  if (read(2, 2) != 42) b.fail("a TIFF file of a kind cgsr does not read (BigTIFF?)");
+  const size_t ifd = read(4, 4);
+  const uint32_t entries = read(ifd, 2);
+  ImageHeader h{"TIFF", -1, -1};
+  for (uint32_t i = 0; i < entries; ++i) {
+    const size_t e = ifd + 2 + 12 * static_cast<size_t>(i);
+    const uint32_t tag = read(e, 2), type = read(e + 2, 2);
+    if (tag != 256 && tag != 257) continue;
+    const int64_t value = type == 3 ? read(e + 8, 2) : read(e + 8, 4);  // SHORT or LONG
+    (tag == 256 ? h.width : h.height) = value;
+  }
+  if (h.width < 0 || h.height < 0) b.fail("a TIFF file without its width and height tags");
+  return h;
+}
+
+ImageHeader exr(const Bytes& b) {
+  // Magic and version, then attributes "name\0type\0<int32 size><value>" up to an empty name.
+  size_t at = 8;
+  while (true) {
+    const size_t name_end = b.data().find('\0', at);
+    if (name_end == std::string::npos) b.fail(kCutShort);
+    const std::string name = b.data().substr(at, name_end - at);
+    if (name.empty()) b.fail("an OpenEXR header without a dataWindow");
+    const size_t type_end = b.data().find('\0', name_end + 1);
+    if (type_end == std::string::npos) b.fail(kCutShort);
+    const std::string type = b.data().substr(name_end + 1, type_end - name_end - 1);
+    const uint32_t size = b.le(type_end + 1, 4);
+    const size_t value = type_end + 5;
+    if (name == "dataWindow") {
+      if (type != "box2i" || size != 16) b.fail("an OpenEXR dataWindow that is not a box2i");
+      const auto i32 = [&](size_t k) { return static_cast<int64_t>(static_cast<int32_t>(b.le(value + 4 * k, 4))); };
+      const int64_t width = i32(2) - i32(0) + 1, height = i32(3) - i32(1) + 1;
+      if (width < 1 || height < 1) b.fail("an OpenEXR dataWindow of no pixels");
+      return {"EXR", width, height};
+    }
+    b.need(value, size);
+    at = value + size;
+  }
+}
+
+}  // namespace
+
+ImageHeader parse_image_header(const std::string& bytes, const std::string& context) {
+  const Bytes b(bytes, context);
+  if (b.starts_with("\x89PNG\r\n\x1a\n")) return png(b);
+  if (b.starts_with("\xFF\xD8")) return jpeg(b);
+  if (b.size() >= 2 && b.u8(0) == 'P' && b.u8(1) >= '1' && b.u8(1) <= '6') return pnm(b);
+  if (b.starts_with("BM")) return bmp(b);
+  if (b.starts_with(std::string("II*\0", 4)) || b.starts_with(std::string("MM\0*", 4))) return tiff(b);
+  if (b.starts_with("\x76\x2f\x31\x01")) return exr(b);
+  throw Error(context, "unreadable image: not a format cgsr reads (PNG, JPEG, PPM/PGM, BMP, TIFF or OpenEXR)");
+}
+
+void check_image_limits(const ImageHeader& header, const std::string& context) {
+  if (header.width >= 1 && header.height >= 1 && header.width <= kMaxImageSide && header.height <= kMaxImageSide &&
+      header.width * header.height <= kMaxImagePixels)
+    return;
+  throw Error(context, "the " + header.format + " header declares " + std::to_string(header.width) + "x" +
+                           std::to_string(header.height) + " pixels, beyond the limit of " +
+                           std::to_string(kMaxImageSide) + " a side and " + std::to_string(kMaxImagePixels) +
+                           " pixels (the file was not decoded)");
+}
+
+ImageHeader read_image_header(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string(), "cannot read the image file");
+  // Headers sit in the first bytes, but JPEG metadata (EXIF thumbnails) and TIFF directories may
+  // push the size further: 64 KiB first, 4 MiB when that is not enough.
+  std::string head;
+  for (const size_t limit : {size_t{1} << 16, size_t{1} << 22}) {
+    head.resize(limit);
+    in.clear();
+    in.seekg(0);
+    in.read(head.data(), static_cast<std::streamsize>(limit));
+    head.resize(static_cast<size_t>(in.gcount()));
+    try {
+      return parse_image_header(head, path.string());
+    } catch (const Error& e) {
+      const std::string what = e.message();
+      const bool cut_short = what.size() >= std::strlen(kCutShort) &&
+                             what.compare(what.size() - std::strlen(kCutShort), std::string::npos, kCutShort) == 0;
+      if (!cut_short || head.size() < limit) throw;
+    }
+  }
+  return parse_image_header(head, path.string());
+}
+
+}  // namespace cgsr

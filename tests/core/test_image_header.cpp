@@ -1,0 +1,98 @@
+// Image headers read without decoding: the size of every format cgsr reads, and the checks made
+// with it before a decoder allocates what a header declares (a decompression bomb).
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/image_header.h"
+#include "core/image_io.h"
+
+using namespace cgsr;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path header_dir() {
+  static const fs::path dir = [] {
+    auto d = fs::temp_directory_path() / ("cgsr-test-image-header-" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// The bomb seed of fuzz_frame_files (fuzz/make_seeds.sh): a valid PNG of about 1 KB that declares
+// 20000x20000 RGB pixels and holds 16 rows of them; the seed's first byte is the file kind.
+std::string png_bomb() {
+  const std::string seed = read_file(fs::path(CGSR_SOURCE_DIR) / "fuzz/corpus/frame_files/color_bomb_20000x20000.bin");
+  return seed.substr(1);
+}
+
+std::string header_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::User) << e.what();
+    return e.what();
+  }
+  return "no error";
+}
+}  // namespace
+
+TEST(ImageHeader, ReadsTheSizeOfEveryFormatCgsrReads) {
+  const auto image = torch::rand({3, 9, 13});
+  for (const std::string name : {"a.png", "a.ppm", "a.bmp", "a.tif", "a.exr"}) {
+    write_image(header_dir() / name, image, {name == "a.tif" || name == "a.exr" ? 32 : 8});
+    const ImageHeader h = read_image_header(header_dir() / name);
+    EXPECT_EQ(h.width, 13) << name;
+    EXPECT_EQ(h.height, 9) << name;
+  }
+  write_image(header_dir() / "g.pgm", torch::rand({1, 5, 7}));
+  EXPECT_EQ(read_image_header(header_dir() / "g.pgm").width, 7);
+  // JPEG (read, never written by cgsr): the size sits in the frame header after the metadata.
+  std::vector<unsigned char> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", cv::Mat(21, 34, CV_8UC3, cv::Scalar(1, 2, 3)), jpeg));
+  const ImageHeader h = parse_image_header(std::string(jpeg.begin(), jpeg.end()), "a.jpg");
+  EXPECT_EQ(h.format, "JPEG");
+  EXPECT_EQ(h.width, 34);
+  EXPECT_EQ(h.height, 21);
+}
+
+TEST(ImageHeader, CutShortAndUnknownHeadersAreErrorsNamingTheFile) {
+  EXPECT_NE(header_error_of([] { parse_image_header(std::string("\x89PNG\r\n\x1a\n\0\0", 10), "x.png"); })
+                .find("x.png: unreadable image: the image header is cut short"),
+            std::string::npos);
+  EXPECT_NE(header_error_of([] { parse_image_header("GIF89a....", "x.gif"); }).find("x.gif: unreadable image: not a format"),
+            std::string::npos);
+  EXPECT_NE(header_error_of([] { parse_image_header("P6\n# only a comment\n", "x.ppm"); }).find("x.ppm: unreadable image"),
+            std::string::npos);
+}
+
+// The bomb: ~1 KB on disk, 20000x20000 declared, placed where a 64x48 frame belongs.
+// It used to be decoded in full (2.5 GB) before its size was checked.
+TEST(ImageHeader, ADecompressionBombIsRefusedBeforeDecoding) {
+  const fs::path bomb = header_dir() / "bomb.png";
+  write_file_atomic(bomb, png_bomb());
+  ASSERT_LT(fs::file_size(bomb), 4096u);
+  EXPECT_EQ(read_image_header(bomb).width, 20000);
+  std::string e = header_error_of([&] { read_image(bomb, {3, 64, 48}); });
+  EXPECT_NE(e.find(bomb.string() + ": size 20000x20000 (from the PNG header; not decoded) does not match the "
+                                   "resolution 64x48"),
+            std::string::npos)
+      << e;
+  // Of unknown size, it is held to the limits.
+  e = header_error_of([&] { read_image(bomb); });
+  EXPECT_NE(e.find("declares 20000x20000 pixels, beyond the limit of 16384 a side"), std::string::npos) << e;
+  // Within the limits but not the frame's size.
+  const fs::path large = header_dir() / "large.png";
+  write_image(large, torch::rand({3, 480, 640}));
+  e = header_error_of([&] { read_image(large, {3, 64, 48}); });
+  EXPECT_NE(e.find("size 640x480 (from the PNG header; not decoded) does not match the resolution 64x48"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(read_image(large, {3, 640, 480}).size(2), 640);
+}
