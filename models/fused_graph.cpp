@@ -23,6 +23,15 @@ using Dims = memory::dims;
 using graph::Op;
 using graph::OpKind;
 constexpr auto kF32 = memory::data_type::f32;
+constexpr auto kS8 = memory::data_type::s8;
+
+const char* type_name(memory::data_type t) {
+  switch (t) {
+    case memory::data_type::bf16: return "bf16";
+    case memory::data_type::s8: return "int8";
+    default: return "fp32";
+  }
+}
 
 std::string dims_string(const Dims& d) {
   std::string s = "[";
@@ -57,6 +66,11 @@ torch::Tensor own(const torch::Tensor& t) {
 
 void* data(const torch::Tensor& t) { return const_cast<void*>(t.data_ptr()); }
 
+std::vector<float> as_vector(const torch::Tensor& t) {
+  const torch::Tensor c = t.to(torch::kFloat).contiguous();
+  return {c.data_ptr<float>(), c.data_ptr<float>() + c.numel()};
+}
+
 // Per-channel tensors ([C]) as the broadcast operand of a binary op or post-op.
 memory::desc channel_md(int64_t c) { return memory::desc({1, c, 1, 1}, kF32, memory::format_tag::nchw); }
 
@@ -90,6 +104,7 @@ struct Call {
   std::vector<ValueArg> values;
   std::unordered_map<int, memory> args;
   memory::desc scratchpad;
+  std::vector<torch::Tensor> constants;  // tensors `args` point into that only this call owns
 };
 
 template <class PrimitiveDesc>
@@ -284,6 +299,7 @@ class Compiler {
     p_.mds.assign(g_.values.size(), memory::desc());
     for (size_t v = 0; v < g_.values.size(); ++v)
       if (!virtual_[v]) p_.mds[v] = memory::desc(p_.dims[v], kF32, tag_);
+    choose_precisions();
     done_.assign(g_.ops.size(), false);
     position_of_.assign(g_.ops.size(), -1);
     for (int i = 0; i < static_cast<int>(g_.ops.size()); ++i)
@@ -298,7 +314,87 @@ class Compiler {
  private:
   int64_t width(int v) const { return p_.dims[v][1]; }
   const memory::desc& md(int v) const { return p_.mds[v]; }
-  std::string value_name(int v) const { return g_.values[v].name; }
+  std::string value_name(int v) const {
+    return v < static_cast<int>(g_.values.size()) ? g_.values[v].name : value_name(source_of_.at(v));
+  }
+
+  // ---- precision ---------------------------------------------------------------------------------
+  // Which convolutions compute in the low format: all but the wide ones, which read a graph input
+  // or write a graph output through element-wise ops only (the first and last layers).
+  void choose_precisions() {
+    low_ = options_.precision == Precision::Bf16   ? memory::data_type::bf16
+           : options_.precision == Precision::Int8 ? kS8
+                                                   : kF32;
+    const size_t values = g_.values.size(), ops = g_.ops.size();
+    conv_low_.assign(ops, false);
+    source_of_.assign(values, -1);
+    shadow_.assign(values, -1);
+    if (low_ == kF32) return;
+    std::vector<bool> from_input(values, false), to_output(values, false);
+    for (const auto& [name, v] : g_.inputs) from_input[v] = true;
+    for (const Op& op : g_.ops)
+      if (op.kind != OpKind::Conv)
+        for (int in : op.inputs) from_input[op.output] = from_input[op.output] || from_input[in];
+    for (const auto& [name, v] : g_.outputs) to_output[v] = true;
+    for (size_t i = ops; i-- > 0;)
+      if (g_.ops[i].kind != OpKind::Conv)
+        for (int in : g_.ops[i].inputs) to_output[in] = to_output[in] || to_output[g_.ops[i].output];
+    for (size_t i = 0; i < ops; ++i) {
+      const Op& op = g_.ops[i];
+      conv_low_[i] = op.kind == OpKind::Conv && !from_input[op.inputs[0]] && !to_output[op.output];
+    }
+  }
+
+  bool is_low_conv(int op) const { return g_.ops[op].kind == OpKind::Conv && conv_low_[op]; }
+
+  // Whether `value` is stored in the low format when a low-precision convolution writes it: every
+  // reader is a low-precision convolution (directly or through a concatenation that is never built).
+  bool stored_low(int value) const {
+    if (low_ == kF32 || is_output_[value] || uses_[value].empty()) return false;
+    for (int u : uses_[value]) {
+      const Op& op = g_.ops[u];
+      if (op.kind == OpKind::Concat && virtual_[op.output]) {
+        for (int c : uses_[op.output])
+          if (!is_low_conv(c)) return false;
+      } else if (!is_low_conv(u)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // The INT8 step of a value (or of the value a converted copy was made from).
+  float scale(int value) const {
+    if (value >= static_cast<int>(g_.values.size())) return scale(source_of_.at(value));
+    return int8_scale(options_.calibration.range(g_.values[value].name));
+  }
+
+  // `value` in the low format for a convolution at op `position`: the value itself when its
+  // writer stored it so, else a copy converted once, by a step placed before that convolution.
+  int low_copy(int value, int position) {
+    if (md(value).data_type() == low_) return value;
+    if (shadow_[value] >= 0) return shadow_[value];
+    const int copy = static_cast<int>(p_.dims.size());
+    p_.dims.push_back(p_.dims[value]);
+    p_.mds.push_back(memory::desc(p_.dims[value], low_, tag_));
+    source_of_.push_back(value);
+    shadow_.push_back(-1);
+    shadow_[value] = copy;
+    PlannedStep step;
+    step.info = {"convert", {value_name(value)}, "", type_name(low_)};
+    dnnl::primitive_attr a = attr();
+    if (low_ == kS8) a.set_output_scales(0, {1.f / scale(value)});
+    const dnnl::reorder::primitive_desc pd(p_.engine, md(value), p_.engine, md(copy), a);
+    add_implementation(step, pd.impl_info_str());
+    Call call = make_call<dnnl::reorder::primitive_desc, dnnl::reorder>(pd);
+    call.values = {{DNNL_ARG_FROM, value, {}}, {DNNL_ARG_TO, copy, {}}};
+    step.calls.push_back(std::move(call));
+    step.position = position;
+    step.reads = {value};
+    step.writes = copy;
+    p_.steps.push_back(std::move(step));
+    return copy;
+  }
 
   dnnl::primitive_attr attr(const dnnl::post_ops& post = {}) const {
     dnnl::primitive_attr a;
@@ -451,9 +547,11 @@ class Compiler {
         const std::vector<int> chain(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(n));
         for (bool in_place : {true, false}) {
           PlannedStep step;
+          committed_md_ = {-1, {}};
           const bool ok =
               op.kind == OpKind::Conv ? plan_conv(i, chain, step, in_place) : !in_place && plan_binary(i, chain, step);
           if (ok && (n == 0 || !is_reference(step.info.implementation))) {
+            if (committed_md_.first >= 0) p_.mds[committed_md_.first] = committed_md_.second;
             finish(i, chain, std::move(step));
             return;
           }
@@ -546,64 +644,102 @@ class Compiler {
       step.info.ops = {op.name};
     }
     const int out = chain_end(op.output, chain);
+    // A low-precision convolution reads its parts in the low format and writes it when every
+    // reader of its result takes it; a wide one computes in float32.
+    const bool low = conv_low_[i];
+    const memory::data_type type = low ? low_ : kF32;
+    const memory::desc out_md(p_.dims[out], low && stored_low(out) ? low_ : kF32, tag_);
+    const bool int8 = type == kS8, int8_out = out_md.data_type() == kS8;
+    step.info.precision = type_name(type);
     if (in_place && !options_.sum_in_place) return false;
+    if (in_place && out_md.data_type() != kF32) return false;  // residuals are float32
     const auto [summed, residual] = in_place ? in_place_add(i, chain, parts.size() > 1) : std::pair{-1, -1};
     if (in_place && summed < 0) return false;
     if (summed >= 0) {
       step.overwrites = residual;
       step.reads.push_back(residual);
     }
+    // INT8: the kernel scales its int32 sums to real values (source step x weight step per output
+    // channel) before the post-ops, which then compute in float32, and a last linear post-op
+    // steps into the destination's int8 units. When the post-ops are only (leaky) ReLUs, which
+    // commute with a positive factor, that factor goes into the output scales instead.
+    bool homogeneous = true;
+    for (int j : chain) homogeneous = homogeneous && (g_.ops[j].kind == OpKind::Relu || g_.ops[j].kind == OpKind::LeakyRelu);
+    const float out_step = int8_out ? scale(out) : 1.f;
     const int64_t kh = op.weight.size(2), kw = op.weight.size(3), oc = op.weight.size(0), g = op.groups;
     for (size_t k = 0; k < parts.size(); ++k) {
-      const int64_t ic = width(parts[k].value);
+      const bool last = k + 1 == parts.size();
+      const int src = low ? low_copy(parts[k].value, i) : parts[k].value;
+      const int64_t ic = width(src);
       const torch::Tensor weight =
           parts.size() == 1 ? op.weight : op.weight.slice(1, parts[k].offset, parts[k].offset + ic).contiguous();
       const bool bias = k == 0 && op.bias.defined();
       const Dims weight_dims = g > 1 ? Dims{g, oc / g, ic / g, kh, kw} : Dims{oc, ic, kh, kw};
-      const memory::desc weight_any(weight_dims, kF32, memory::format_tag::any);
+      const memory::desc weight_any(weight_dims, type, memory::format_tag::any);
       const memory::desc weight_user(weight_dims, kF32, g > 1 ? memory::format_tag::goihw : memory::format_tag::oihw);
       const memory::desc bias_md = bias ? memory::desc({oc}, kF32, memory::format_tag::x) : memory::desc();
+      const bool folded = int8_out && (!last || homogeneous);
+      torch::Tensor weight_steps, output_scales;
+      if (int8) {
+        weight_steps = int8_channel_scales(weight);
+        output_scales = weight_steps * scale(src) / (folded ? out_step : 1.f);
+      }
       Call call;
       dnnl::post_ops post;
       int index = 0;
       const bool split = parts.size() > 1;
       if (k > 0 || (split && summed >= 0)) {
-        post.append_sum(1.f);
+        post.append_sum(k > 0 && int8_out && !folded ? out_step : 1.f);
         ++index;
       }
-      if (k + 1 == parts.size()) append_chain(chain, op.output, post, index, call, step, summed, split);
+      if (last) append_chain(chain, op.output, post, index, call, step, summed, split);
+      if (int8_out && !folded) post.append_eltwise(1.f, dnnl::algorithm::eltwise_linear, 1.f / out_step, 0.f);
+      dnnl::primitive_attr conv_attr = attr(post);
+      if (int8) conv_attr.set_output_scales(1 << 1, as_vector(output_scales));
       const dnnl::convolution_forward::desc desc(
-          dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, md(parts[k].value), weight_any,
-          bias_md, md(out), {op.stride, op.stride}, {op.dilation - 1, op.dilation - 1}, {op.padding, op.padding},
+          dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, md(src), weight_any, bias_md,
+          out_md, {op.stride, op.stride}, {op.dilation - 1, op.dilation - 1}, {op.padding, op.padding},
           {op.padding, op.padding});
-      dnnl::convolution_forward::primitive_desc pd(desc, attr(post), p_.engine, /*allow_empty=*/true);
+      dnnl::convolution_forward::primitive_desc pd(desc, conv_attr, p_.engine, /*allow_empty=*/true);
       if (!pd) return false;
       if (options_.tune) {
         std::vector<std::pair<int, memory::desc>> operands;
         for (const auto& a : call.values) operands.emplace_back(a.arg, md(a.value));
         for (const auto& [arg, m] : call.args) operands.emplace_back(arg, m.get_desc());
-        const std::string key = "conv " + dims_string(md(parts[k].value).dims()) + " " +
-                                std::to_string(static_cast<int>(tag_)) + " w" + dims_string(weight_dims) + " s" +
-                                std::to_string(op.stride) + " p" + std::to_string(op.padding) + " d" +
-                                std::to_string(op.dilation) + (bias ? " bias" : "") + post_ops_key(post);
-        pd = fastest_convolution(desc, attr(post), pd, operands, key, p_.engine, p_.stream);
+        const std::string key = "conv " + dims_string(md(src).dims()) + " " + std::to_string(static_cast<int>(tag_)) +
+                                " " + type_name(md(src).data_type()) + "->" + type_name(out_md.data_type()) + " w" +
+                                dims_string(weight_dims) + " s" + std::to_string(op.stride) + " p" +
+                                std::to_string(op.padding) + " d" + std::to_string(op.dilation) +
+                                (bias ? " bias" : "") + post_ops_key(post);
+        pd = fastest_convolution(desc, conv_attr, pd, operands, key, p_.engine, p_.stream);
       }
       add_implementation(step, pd.impl_info_str());
       Call made = make_call<dnnl::convolution_forward::primitive_desc, dnnl::convolution_forward>(pd);
       made.args = std::move(call.args);
       made.values = std::move(call.values);
-      // The weights are reordered once, here, into the layout the kernel asked for.
+      made.constants = std::move(call.constants);
+      // The weights are converted and reordered once, here, into the layout the kernel asked
+      // for; INT8 weights are rounded to their channel's step.
       memory reordered(pd.weights_desc(), p_.engine);
       memory user(weight_user, p_.engine, data(weight));
-      dnnl::reorder(user, reordered).execute(p_.stream, user, reordered);
+      dnnl::primitive_attr to_kernel;
+      if (int8) to_kernel.set_output_scales(g > 1 ? (1 << 0) | (1 << 1) : 1 << 0, as_vector(1.f / weight_steps));
+      dnnl::reorder(dnnl::reorder::primitive_desc(p_.engine, weight_user, p_.engine, pd.weights_desc(), to_kernel))
+          .execute(p_.stream, user, reordered);
       p_.stream.wait();
       made.args[DNNL_ARG_WEIGHTS] = reordered;
-      if (bias) made.args[DNNL_ARG_BIAS] = memory(pd.bias_desc(), p_.engine, data(op.bias));
-      made.values.push_back({DNNL_ARG_SRC, parts[k].value, {}});
+      if (bias) {
+        // INT8 kernels add the bias to the int32 sums, before the output scales.
+        torch::Tensor b = int8 ? (op.bias / (weight_steps * scale(src))).contiguous() : op.bias;
+        made.constants.push_back(b);
+        made.args[DNNL_ARG_BIAS] = memory(pd.bias_desc(), p_.engine, data(b));
+      }
+      made.values.push_back({DNNL_ARG_SRC, src, {}});
       made.values.push_back({DNNL_ARG_DST, out, {}});
-      step.reads.push_back(parts[k].value);
+      step.reads.push_back(src);
       step.calls.push_back(std::move(made));
     }
+    committed_md_ = {out, out_md};
     return true;
   }
 
@@ -761,7 +897,7 @@ class Compiler {
   // the widest point of the graph rather than the sum of all activations.
   void place_values() {
     const int steps = static_cast<int>(p_.steps.size());
-    const size_t count = g_.values.size();
+    const size_t count = p_.dims.size();  // graph values and converted copies
     constexpr int kNever = -3;
     std::vector<int> last(count, -2);
     for (int s = 0; s < steps; ++s)
@@ -859,6 +995,11 @@ class Compiler {
   std::vector<std::vector<int>> uses_;
   std::vector<bool> is_output_, virtual_, done_;
   std::vector<int> position_of_;  // per op: position of the step computing it (once planned)
+  memory::data_type low_ = kF32;  // the format of low-precision convolutions
+  std::vector<bool> conv_low_;    // per op: a convolution computing in low_
+  std::vector<int> shadow_;       // per value: its converted copy, or -1
+  std::vector<int> source_of_;    // per value: what a converted copy was made from (-1: none)
+  std::pair<int, memory::desc> committed_md_{-1, {}};  // the destination a conv plan stores in low_
   std::vector<int> buffer_of_;
   std::vector<Call*> scratch_calls_;
 };
@@ -876,6 +1017,8 @@ FusedGraph::FusedGraph(const graph::Graph& graph) : FusedGraph(graph, Options())
 FusedGraph::FusedGraph(const graph::Graph& graph, Options options) : graph_(graph), options_(options) {
   CGSR_CHECK(!graph_.inputs.empty() && !graph_.outputs.empty(), "fused graph: a graph needs inputs and outputs");
   CGSR_CHECK(options_.cached_plans >= 1, "fused graph: cached_plans must be at least 1");
+  if (options_.precision == Precision::Int8 && options_.calibration.ranges.empty())
+    throw Error("fused graph", "int8 needs a calibration of the graph's activations (calibrate())");
   for (auto& op : graph_.ops) {
     op.weight = own(op.weight);
     op.bias = own(op.bias);

@@ -12,8 +12,14 @@
 //   - a concatenation read only by 1x1 convolutions is never built: each such convolution runs
 //     once per part and sums the parts in its output (sum post-op);
 //   - resizes (nearest, bilinear), average pooling, pixel shuffle and the remaining element-wise
-//     ops are oneDNN primitives; bicubic resizing goes through graph::apply_resize (LibTorch).
-// The result equals graph::run up to float rounding (different summation orders), for finite
+//     ops are oneDNN primitives; bicubic resizing goes through graph::apply_resize (LibTorch);
+//   - with Precision::Bf16 or Int8 (precision.h), convolutions compute in that format, except the
+//     wide ones: those reading the graph's inputs (colour, depth spanning decades) and those
+//     writing its outputs. A value is stored in the low format when every op reading it is a
+//     low-precision convolution; otherwise it stays float32 (residuals, attention maps, the
+//     operands of element-wise ops), and a low-precision convolution reading it gets a converted
+//     copy made once. Element-wise post-ops compute in float32 on the dequantized result.
+// In float32 the result equals graph::run up to float rounding (different summation orders), for finite
 // input: oneDNN's fused ReLU turns NaN into 0 where LibTorch keeps it (data sets reject
 // non-finite frames when they load, so no data path feeds NaN).
 //
@@ -36,6 +42,7 @@
 #include <vector>
 
 #include "models/graph.h"
+#include "models/precision.h"
 
 namespace cgsr {
 
@@ -56,6 +63,8 @@ class FusedGraph {
                                // default: a choice made by timing can differ between two runs, and
                                // so could their last bits (evaluations must reproduce exactly)
     size_t cached_plans = 4;   // plans kept for different input sizes
+    Precision precision = Precision::Fp32;
+    Calibration calibration;   // Int8: the ranges of the graph's values (calibrate())
   };
 
   // What a plan executes, one entry per step, in order (for tests, logs and profiles).
@@ -63,6 +72,7 @@ class FusedGraph {
     std::string kind;                // "conv", "binary", "eltwise", "resampling", "torch", ...
     std::vector<std::string> ops;    // names of the graph ops it computes, the first one leading
     std::string implementation;      // oneDNN's implementation ("jit:avx512_core", ...) or "torch"
+    std::string precision = "fp32";  // the format it computes in: "fp32", "bf16" or "int8"
   };
 
   explicit FusedGraph(const graph::Graph& graph);

@@ -29,6 +29,7 @@ config::Schema<BenchOptions> bench_schema() {
   s.field("warmup", &BenchOptions::warmup, "untimed runs first").range(0, 1000);
   s.field("runs", &BenchOptions::runs, "timed runs").range(1, 100000);
   s.field("engine", &BenchOptions::engine, "inference engine: fused (oneDNN) or libtorch");
+  s.field("precisions", &BenchOptions::precisions, "number formats of the fused engine: fp32, bf16, int8");
   s.field("layout", &BenchOptions::layout, "activation memory layout of the libtorch engine");
   s.field("layers", &BenchOptions::layers, "also time every layer of the network");
   s.field("json", &BenchOptions::json, "print JSON instead of a table");
@@ -36,6 +37,9 @@ config::Schema<BenchOptions> bench_schema() {
   s.validate([](const BenchOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (o.model.empty() && o.onnx.empty())
       at.child("model").fail(node, "nothing to time: give --model NAME_OR_FILE and/or --onnx FILE");
+    if (o.precisions.empty()) at.child("precisions").fail(node, "give at least one precision");
+    if (o.engine != InferenceEngine::Fused && o.precisions != std::vector<Precision>{Precision::Fp32})
+      at.child("precisions").fail(node, "only the fused engine runs in reduced precision");
   });
   add_run_settings(s);
   return s;
@@ -94,7 +98,7 @@ BenchResult time_onnx(const BenchOptions& options) {
   return r;
 }
 
-BenchTarget model_target(const BenchOptions& options) {
+BenchTarget model_target(const BenchOptions& options, Precision precision) {
   const auto [w, h] = parse_size(options.input, "--input");
   ModelSource source = bench_source(options);
   SRNetwork net = source.network;
@@ -109,9 +113,14 @@ BenchTarget model_target(const BenchOptions& options) {
   t.macs = complexity(*net, w, h).macs * options.batch;
   if (options.engine == InferenceEngine::Fused) {
     net->eval();
-    auto fused = std::make_shared<FusedGraph>(net->describe());
+    const graph::Graph g = net->describe();
+    FusedGraph::Options fused_options;
+    fused_options.precision = precision;
+    if (precision == Precision::Int8)
+      fused_options.calibration = calibrate(g, {network_inputs(g, color, info)}, CalibrationMethod::Max);
+    auto fused = std::make_shared<FusedGraph>(g, fused_options);
     t.runtime = "cgsr fused";
-    t.detail = "oneDNN";
+    t.detail = "oneDNN " + enum_name(precision);
     t.run = [fused, color, info] { fused->run(color, info); };
     return t;
   }
@@ -174,30 +183,29 @@ BenchResult time_target(const BenchTarget& target, int warmup, int runs) {
 
 nlohmann::ordered_json run_bench(const BenchOptions& options) {
   std::vector<BenchTarget> targets;
-  targets.push_back(model_target(options));
+  for (Precision p : options.precisions) targets.push_back(model_target(options, p));
   nlohmann::ordered_json results;
   results["input"] = options.input;
   results["batch"] = options.batch;
   results["threads"] = thread_count();
   results["warmup"] = options.warmup;
   results["runs"] = options.runs;
-  auto rows = nlohmann::ordered_json::array();
   std::vector<BenchResult> timed;
-  for (const auto& t : targets) {
-    timed.push_back(time_target(t, options.warmup, options.runs));
-    const auto& r = timed.back();
-    rows.push_back({{"name", t.name},
-                    {"runtime", t.runtime},
-                    {"detail", t.detail},
-                    {"macs", t.macs},
-                    {"median_ms", r.latency.median_ms},
-                    {"min_ms", r.latency.min_ms},
-                    {"max_ms", r.latency.max_ms},
-                    {"gflops", r.gflops}});
-  }
+  for (const auto& t : targets) timed.push_back(time_target(t, options.warmup, options.runs));
   if (!options.onnx.empty()) {
     timed.push_back(time_onnx(options));
-    const auto& r = timed.back();
+    results["onnxruntime_vs_cgsr"] = timed.back().latency.median_ms / timed.front().latency.median_ms;
+  }
+  // Each reduced precision against float32 on the same input in the same run.
+  const auto fp32 = std::find(options.precisions.begin(), options.precisions.end(), Precision::Fp32);
+  if (fp32 != options.precisions.end() && options.precisions.size() > 1) {
+    const double base = timed[static_cast<size_t>(fp32 - options.precisions.begin())].latency.median_ms;
+    for (size_t i = 0; i < options.precisions.size(); ++i)
+      if (options.precisions[i] != Precision::Fp32)
+        results["speedup_vs_fp32"][enum_name(options.precisions[i])] = base / timed[i].latency.median_ms;
+  }
+  auto rows = nlohmann::ordered_json::array();
+  for (const auto& r : timed)
     rows.push_back({{"name", r.target.name},
                     {"runtime", r.target.runtime},
                     {"detail", r.target.detail},
@@ -206,8 +214,6 @@ nlohmann::ordered_json run_bench(const BenchOptions& options) {
                     {"min_ms", r.latency.min_ms},
                     {"max_ms", r.latency.max_ms},
                     {"gflops", r.gflops}});
-    results["onnxruntime_vs_cgsr"] = r.latency.median_ms / timed.front().latency.median_ms;
-  }
   results["results"] = rows;
   if (options.layers) results["layers"] = layer_profile(options);
   if (options.json) {
@@ -224,6 +230,9 @@ nlohmann::ordered_json run_bench(const BenchOptions& options) {
                 format_count(static_cast<double>(r.target.macs)).c_str());
   if (results.contains("onnxruntime_vs_cgsr"))
     std::printf("ONNX Runtime median / our median: %.2fx\n", results["onnxruntime_vs_cgsr"].get<double>());
+  if (results.contains("speedup_vs_fp32"))
+    for (const auto& [name, ratio] : results["speedup_vs_fp32"].items())
+      std::printf("fp32 median / %s median: %.2fx\n", name.c_str(), ratio.get<double>());
   if (options.layers) {
     std::printf("\nper layer (graph interpreter, NCHW, mean of %d runs; slowest first)\n", options.runs);
     std::printf("%-44s %-14s %9s %7s %9s %9s\n", "layer", "kind", "ms", "share", "GFLOP/s", "MACs");

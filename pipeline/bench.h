@@ -16,6 +16,7 @@
 #include "models/inference.h"
 #include "models/memory_layout.h"
 #include "models/model_source.h"
+#include "models/precision.h"
 #include "pipeline/run_settings.h"
 
 namespace cgsr {
@@ -28,6 +29,7 @@ struct BenchOptions : RunSettings {
   int warmup = 3;
   int runs = 20;
   InferenceEngine engine = InferenceEngine::Fused;
+  std::vector<Precision> precisions = {Precision::Fp32};  // of the fused engine, each timed in turn
   MemoryLayout layout = MemoryLayout::Auto;  // activation layout of the libtorch engine
   bool layers = false;          // also time every layer (graph interpreter, NCHW)
   bool json = false;
@@ -55,8 +57,9 @@ config::Schema<BenchOptions> bench_schema();
 ModelSource bench_source(const BenchOptions& options);
 // The --onnx file timed in ONNX Runtime (export/onnxruntime_runner.h) on inputs of the --model shapes.
 BenchResult time_onnx(const BenchOptions& options);
-// The LibTorch target of --model.
-BenchTarget model_target(const BenchOptions& options);
+// The --model target of the chosen engine (the fused one at `precision`). INT8 is calibrated on
+// the timed input itself: its latency does not depend on the scales.
+BenchTarget model_target(const BenchOptions& options, Precision precision = Precision::Fp32);
 // Mean time of each op of the --model network's graph over the timed runs, slowest first.
 nlohmann::ordered_json layer_profile(const BenchOptions& options);
 BenchResult time_target(const BenchTarget& target, int warmup, int runs);

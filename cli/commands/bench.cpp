@@ -16,6 +16,8 @@ void setup_bench(CLI::App& app) {
         flag_to_key(sub, flags, "--warmup", "warmup", "untimed runs first");
         flag_to_key(sub, flags, "--runs", "runs", "timed runs");
         flag_to_key(sub, flags, "--engine", "engine", "inference engine: fused or libtorch");
+        list_to_key(sub, flags, "--precision", "precisions", "number formats of the fused engine: fp32, bf16, int8",
+                    "PRECISION");
         flag_to_key(sub, flags, "--layout", "layout", "activation layout of the libtorch engine: auto, nchw or nhwc");
         switch_to_key(sub, flags, "--layers", "layers", "also time every layer of the network");
         switch_to_key(sub, flags, "--json", "json", "print JSON instead of a table");
