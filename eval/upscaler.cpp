@@ -45,15 +45,19 @@ const Registry<ClassicFactory>& classic_upscalers() {
   return registry;
 }
 
-NetworkUpscaler::NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine)
-    : name_(std::move(name)), network_(std::move(network)), engine_(engine) {}
+NetworkUpscaler::NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine,
+                                 FusedGraph::Options fused)
+    : name_(std::move(name)), network_(std::move(network)), engine_(engine), fused_options_(std::move(fused)) {
+  CGSR_CHECK(engine_ == InferenceEngine::Fused || fused_options_.precision == Precision::Fp32,
+             "network upscaler: only the fused engine runs in reduced precision");
+}
 
 torch::Tensor NetworkUpscaler::upscale(const Batch& batch) {
   const auto info = network_->info_input(batch);
   if (engine_ == InferenceEngine::LibTorch) return infer(*network_, batch.lr_color, info);
   if (!fused_) {
     network_->eval();
-    fused_ = std::make_shared<FusedGraph>(network_->describe());
+    fused_ = std::make_shared<FusedGraph>(network_->describe(), fused_options_);
   }
   return fused_->run(batch.lr_color, info);
 }

@@ -60,11 +60,13 @@ class Upscaler {
 using ClassicFactory = std::function<std::unique_ptr<Upscaler>(int scale)>;
 const Registry<ClassicFactory>& classic_upscalers();
 
-// A trained network, run by the fused inference path unless told otherwise. The fused path
-// snapshots the weights at the first upscale(): the network must not change after that.
+// A trained network, run by the fused inference path unless told otherwise (in the precision of
+// `fused`, which for INT8 carries the calibration). The fused path snapshots the weights at the
+// first upscale(): the network must not change after that.
 class NetworkUpscaler : public Upscaler {
  public:
-  NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine = InferenceEngine::Fused);
+  NetworkUpscaler(std::string name, SRNetwork network, InferenceEngine engine = InferenceEngine::Fused,
+                  FusedGraph::Options fused = {});
   std::string name() const override { return name_; }
   int scale() const override { return network_->spec().scale; }
   std::vector<RenderChannel> channels() const override { return network_->input_channels(); }
@@ -77,6 +79,7 @@ class NetworkUpscaler : public Upscaler {
   std::string name_;
   SRNetwork network_;
   InferenceEngine engine_;
+  FusedGraph::Options fused_options_;
   std::shared_ptr<FusedGraph> fused_;  // built at the first upscale()
 };
 

@@ -28,6 +28,14 @@ config::Schema<EvalCommandOptions> eval_schema() {
   s.section("images", &EvalCommandOptions::images, comparison_schema_fields(),
             "crops and error maps of the evaluated frames with the most geometry edges, into images/");
   s.omit_when("images", [](const EvalCommandOptions& o) { return o.images.frames == 0; });  // stage hashes as before
+  s.field("precisions", &EvalCommandOptions::precisions,
+          "number formats each network runs in on the fused engine: fp32, bf16, int8")
+      .check([](const auto& v) { return !v.empty(); }, "needs at least one precision");
+  s.section("calibration", &EvalCommandOptions::calibration, calibration_schema_fields(),
+            "the frames int8 activation ranges are measured on");
+  const auto only_fp32 = [](const EvalCommandOptions& o) { return o.precisions == std::vector{Precision::Fp32}; };
+  s.omit_when("precisions", only_fp32);
+  s.omit_when("calibration", only_fp32);
   s.validate([](const EvalCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (!o.names.empty() && o.names.size() != o.models.size())
       at.child("names").fail(node["names"] ? node["names"] : node, "needs one name per model");
@@ -57,6 +65,31 @@ Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upsc
     for (auto c : u->channels()) needed.push_back(c);
   if (temporal) needed.push_back(RenderChannel::Motion);
   return open_for_channels(path, needed);
+}
+
+// Every network among `upscalers` in each of `precisions`, next to each other ("name int8");
+// classic upscalers and hybrids (their patterns run in float32) once.
+std::vector<std::unique_ptr<Upscaler>> in_precisions(std::vector<std::unique_ptr<Upscaler>> upscalers,
+                                                     const std::vector<Precision>& precisions, const Dataset& data,
+                                                     const CalibrationOptions& calibration) {
+  if (precisions == std::vector{Precision::Fp32}) return upscalers;
+  std::vector<std::unique_ptr<Upscaler>> out;
+  for (auto& u : upscalers) {
+    auto* network = dynamic_cast<NetworkUpscaler*>(u.get());
+    if (!network) {
+      if (u->cost(1, 1)) spdlog::warn("{}: runs in fp32 only (a hybrid's patterns are not quantized)", u->name());
+      out.push_back(std::move(u));
+      continue;
+    }
+    for (Precision p : precisions) {
+      FusedGraph::Options fused;
+      fused.precision = p;
+      if (p == Precision::Int8) fused.calibration = calibrate_network(*network->network(), data, calibration);
+      const std::string name = p == Precision::Fp32 ? network->name() : network->name() + " " + enum_name(p);
+      out.push_back(std::make_unique<NetworkUpscaler>(name, network->network(), InferenceEngine::Fused, fused));
+    }
+  }
+  return out;
 }
 
 // Comparisons of the `options.frames` frames of `evaluated` with the most geometry edges, with
@@ -90,6 +123,7 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   for (const auto& [entry, name] : entries) upscalers.push_back(make_upscaler(entry, name, options.scale));
   Dataset data = open_for(options.data, upscalers, options.eval.temporal);
   if (!options.scene.empty()) data = data.scene(options.scene);
+  upscalers = in_precisions(std::move(upscalers), options.precisions, data, options.calibration);
   std::vector<EvalResult> results;
   nlohmann::ordered_json json;
   json["data"] = data.info().root.string();

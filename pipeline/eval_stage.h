@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/run_dir.h"
+#include "eval/calibration.h"
 #include "eval/evaluation.h"
 #include "eval/image_comparison.h"
 #include "pipeline/run_settings.h"
@@ -25,6 +26,8 @@ struct EvalCommandOptions : RunSettings {
   int scale = 2;                    // scale of the classic upscalers (model files carry their own)
   EvalOptions eval;
   ComparisonOptions images = no_comparisons();   // crops and error maps of that many frames (none by default)
+  std::vector<Precision> precisions = {Precision::Fp32};  // each network is evaluated in each
+  CalibrationOptions calibration;                         // of int8 activations
 };
 
 config::Schema<EvalCommandOptions> eval_schema();

@@ -21,6 +21,8 @@ void setup_eval(CLI::App& app) {
                     "crops and error maps of the N frames with the most geometry edges, into images/");
         flag_to_key(sub, flags, "--frames", "eval.frames", "frame index range A:B within the split");
         flag_to_key(sub, flags, "--latency-runs", "eval.latency_runs", "timed runs for latency (0 = skip)");
+        list_to_key(sub, flags, "--precision", "precisions",
+                    "number formats each network runs in (fused engine): fp32, bf16, int8", "PRECISION");
       },
       [](const EvalCommandOptions& options, const YAML::Node&, RunDir* run_dir) { return run_eval(options, run_dir); },
       /*always_run_dir=*/true);

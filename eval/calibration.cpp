@@ -1,0 +1,33 @@
+#include "eval/calibration.h"
+
+#include <spdlog/spdlog.h>
+
+#include "render_data/patch_sampler.h"
+
+namespace cgsr {
+
+config::Schema<CalibrationOptions> calibration_schema_fields() {
+  config::Schema<CalibrationOptions> s;
+  s.field("split", &CalibrationOptions::split, "split the frames come from").one_of({"train", "val", "test", "all"});
+  s.field("frames", &CalibrationOptions::frames, "frames measured, spread evenly over the split").range(1, 1000);
+  s.field("method", &CalibrationOptions::method, "range of each activation: max, or percentile (99.99th of |x|)");
+  return s;
+}
+
+Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const CalibrationOptions& options) {
+  const std::vector<int> frames = spread_frames(data.frames(split_from_name(options.split)), options.frames);
+  if (frames.empty())
+    throw Error(data.info().root.string(), "no " + options.split + " frames to calibrate int8 activations on");
+  net.eval();
+  const graph::Graph g = net.describe();
+  std::vector<std::vector<std::pair<std::string, torch::Tensor>>> inputs;
+  for (int frame : frames) {
+    const Batch b = frame_batch(data, frame, net.spec().scale, net.input_channels(), net.depth_encoding());
+    inputs.push_back(network_inputs(g, b.lr_color, net.info_input(b)));
+  }
+  spdlog::info("calibrating int8 activations of {} on {} {} frame(s) ({})", spec_summary(net.spec()), frames.size(),
+               options.split, enum_name(options.method));
+  return calibrate(g, inputs, options.method);
+}
+
+}  // namespace cgsr
