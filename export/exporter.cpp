@@ -39,6 +39,8 @@ ExportedModel export_graph(const graph::Graph& graph, const std::filesystem::pat
   exported.width = options.width;
   exported.height = options.height;
   exported.dynamic_size = options.format == ExportFormat::TorchScript || options.dynamic_size;
+  if (options.int8 && options.format != ExportFormat::Onnx)
+    throw Error("export", "int8 is exported as ONNX (QuantizeLinear/DequantizeLinear), not " + enum_name(options.format));
   if (options.format == ExportFormat::Onnx) {
     OnnxOptions o;
     o.width = options.width;
@@ -46,6 +48,9 @@ ExportedModel export_graph(const graph::Graph& graph, const std::filesystem::pat
     o.dynamic_size = options.dynamic_size;
     o.cubic = options.cubic;
     o.metadata = metadata;
+    o.int8 = options.int8;
+    o.metadata.emplace_back("cgsr.precision", options.int8 ? "int8" : "fp32");
+    if (options.int8) o.metadata.emplace_back("cgsr.calibration", calibration_json(*options.int8).dump());
     write_onnx(out, graph, o);
   } else {
     TorchScriptOptions o;

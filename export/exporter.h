@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +27,7 @@ struct ExportOptions {
   int64_t width = 0, height = 0;  // LR input size: fixed in an ONNX file unless dynamic_size
   bool dynamic_size = false;      // ONNX: symbolic batch/height/width (TorchScript is always size-free)
   CubicResize cubic = CubicResize::Conv;  // ONNX: how a bicubic resize is written
+  std::optional<Calibration> int8;        // ONNX: quantized (QDQ) with these ranges; recorded in the file
 };
 
 struct ExportedModel {

@@ -36,6 +36,8 @@ class Writer {
       throw Error("onnx export", "a fixed-size export needs a positive input size, got " +
                                      std::to_string(options.width) + "x" + std::to_string(options.height));
     names_.resize(graph.values.size());
+    dequantized_.resize(graph.values.size());
+    if (options.int8) int8_convs_ = low_precision_convs(graph);
   }
 
   std::string build() {
@@ -44,11 +46,15 @@ class Writer {
       declare(port, /*output=*/false);
     }
     const int output_value = signature_.output.value;
-    for (const auto& op : graph_.ops) {
+    for (size_t i = 0; i < graph_.ops.size(); ++i) {
+      const graph::Op& op = graph_.ops[i];
       // The op producing the graph output writes `sr` directly.
       const std::string out = claim(op.output == output_value ? std::string(kExportOutput) : op.name);
       names_[op.output] = out;
-      emit(op, out);
+      if (!int8_convs_.empty() && int8_convs_[i])
+        emit_int8_conv(op, out);
+      else
+        emit(op, out);
     }
     if (names_[output_value] != kExportOutput)  // the output is a graph input: nothing computes it
       node("Identity", std::string(kExportOutput) + ".identity", {names_[output_value]}, {claim(kExportOutput)});
@@ -109,12 +115,7 @@ class Writer {
           throw Error(op_context(op.name), "conv weight must be [out, in/groups, k, k]");
         std::vector<std::string> inputs = {in(0), initializer(op.name + ".weight", w, w.sizes().vec())};
         if (op.bias.defined()) inputs.push_back(initializer(op.name + ".bias", op.bias, {w.size(0)}));
-        auto* n = node("Conv", op.name, inputs, {out});
-        attr(n, "kernel_shape", std::vector<int64_t>{w.size(2), w.size(3)});
-        attr(n, "pads", std::vector<int64_t>{op.padding, op.padding, op.padding, op.padding});
-        attr(n, "strides", std::vector<int64_t>{op.stride, op.stride});
-        attr(n, "dilations", std::vector<int64_t>{op.dilation, op.dilation});
-        attr(n, "group", op.groups);
+        conv_attributes(node("Conv", op.name, inputs, {out}), op);
         return;
       }
       case graph::OpKind::Relu: node("Relu", op.name, {in(0)}, {out}); return;
@@ -164,6 +165,67 @@ class Writer {
     }
     throw Error(op_context(op.name), std::string("the ONNX writer does not know op kind '") +
                                          graph::op_kind_name(op.kind) + "'");
+  }
+
+  static void conv_attributes(onnx::NodeProto* n, const graph::Op& op) {
+    attr(n, "kernel_shape", std::vector<int64_t>{op.weight.size(2), op.weight.size(3)});
+    attr(n, "pads", std::vector<int64_t>{op.padding, op.padding, op.padding, op.padding});
+    attr(n, "strides", std::vector<int64_t>{op.stride, op.stride});
+    attr(n, "dilations", std::vector<int64_t>{op.dilation, op.dilation});
+    attr(n, "group", op.groups);
+  }
+
+  // `value` through QuantizeLinear and DequantizeLinear with the step of its calibrated range,
+  // once per value; returns the dequantized tensor's name.
+  std::string dequantized(int value) {
+    if (!dequantized_[value].empty()) return dequantized_[value];
+    const std::string& x = names_.at(value);
+    const float step = int8_scale(options_.int8->range(graph_.values[value].name));
+    dequantized_[value] = quantize_dequantize(x, x, step);
+    return dequantized_[value];
+  }
+
+  std::string quantize_dequantize(const std::string& base, const std::string& x, float step,
+                                  const std::string& out = "") {
+    const std::string scale = initializer(base + ".int8_step", torch::tensor(step), {});
+    const std::string zero = b_.integer_initializer(base + ".int8_zero", torch::zeros({}, torch::kChar), {});
+    const std::string q = claim(base + ".int8");
+    node("QuantizeLinear", base + ".quantize", {x, scale, zero}, {q});
+    const std::string y = out.empty() ? claim(base + ".dequantized") : out;
+    node("DequantizeLinear", base + ".dequantize", {q, scale, zero}, {y});
+    return y;
+  }
+
+  // A convolution in INT8 (OnnxOptions::int8), with the fused path's steps (precision.h): the
+  // input's calibrated step, per-channel weight steps, the bias in int32 units of their product.
+  void emit_int8_conv(const graph::Op& op, const std::string& out) {
+    const auto& w = op.weight;
+    if (op.groups != 1 || w.size(2) != w.size(3))
+      throw Error(op_context(op.name), "int8 export writes square convolutions without groups");
+    const float input_step = int8_scale(options_.int8->range(graph_.values[op.inputs[0]].name));
+    const std::string x = dequantized(op.inputs[0]);
+    const int64_t oc = w.size(0);
+    const torch::Tensor steps = int8_channel_scales(w);
+    const torch::Tensor wq = torch::round(w / steps.view({oc, 1, 1, 1})).clamp(-127, 127).to(torch::kChar);
+    const auto per_channel = [&](const std::string& role, const torch::Tensor& q, const torch::Tensor& s) {
+      const std::string name = claim(op.name + "." + role);
+      auto* n = node("DequantizeLinear", op.name + "." + role + ".dequantize",
+                     {b_.integer_initializer(op.name + "." + role + "_int", q, q.sizes().vec()),
+                      initializer(op.name + "." + role + "_step", s, {oc}),
+                      b_.integer_initializer(op.name + "." + role + "_zero", torch::zeros({oc}, q.scalar_type()), {oc})},
+                     {name});
+      attr(n, "axis", int64_t{0});
+      return name;
+    };
+    std::vector<std::string> inputs = {x, per_channel("weight", wq, steps)};
+    if (op.bias.defined()) {
+      const torch::Tensor bias_steps = steps * input_step;
+      const torch::Tensor bq = torch::round(op.bias.to(torch::kFloat) / bias_steps).to(torch::kInt);
+      inputs.push_back(per_channel("bias", bq, bias_steps));
+    }
+    const std::string y = claim(op.name + ".float");
+    conv_attributes(node("Conv", op.name, inputs, {y}), op);
+    quantize_dequantize(op.name + ".out", y, int8_scale(options_.int8->range(graph_.values[op.output].name)), out);
   }
 
   void emit_resize(const graph::Op& op, const std::string& x, const std::string& out) {
@@ -218,6 +280,8 @@ class Writer {
   ExportSignature signature_;
   OnnxBuilder b_;
   std::vector<std::string> names_;
+  std::vector<std::string> dequantized_;  // per value: its QuantizeLinear/DequantizeLinear output, once made
+  std::vector<bool> int8_convs_;          // per op: written in INT8 (empty: float32 export)
 };
 
 onnx::ModelProto parse_model(const std::string& bytes, const std::string& context) {

@@ -24,12 +24,14 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/enum_names.h"
 #include "models/graph.h"
+#include "models/precision.h"
 
 namespace cgsr {
 
@@ -46,6 +48,12 @@ struct OnnxOptions {
   CubicResize cubic = CubicResize::Conv;
   std::string model_name = "cgsr";                              // graph name
   std::vector<std::pair<std::string, std::string>> metadata;  // metadata_props, e.g. {"cgsr.spec", yaml}
+  // INT8 as QDQ: each convolution low_precision_convs() picks reads its input through a
+  // QuantizeLinear/DequantizeLinear pair (the calibrated step, zero point 0), its weight as int8
+  // per output channel and its bias as int32 through DequantizeLinear, and its result passes a
+  // pair of its own (the step of its calibrated output), so ONNX Runtime runs it as an int8
+  // convolution. Empty: float32.
+  std::optional<Calibration> int8;
 };
 
 inline constexpr int64_t kOnnxOpset = 13;

@@ -40,7 +40,11 @@ torch::Tensor from_blob(const cv::Mat& blob) {
 }  // namespace
 
 std::string opencv_dnn_unsupported_reason(const std::filesystem::path& onnx_file) {
-  if (inspect_onnx_file(onnx_file).dynamic())
+  const OnnxModelInfo info = inspect_onnx_file(onnx_file);
+  if (info.metadata_value("cgsr.precision") == "int8")
+    return "OpenCV DNN 4.6 does not import DequantizeLinear with per-channel int8 weights, so it runs float32 "
+           "exports only; this is an int8 (QDQ) export";
+  if (info.dynamic())
     return "OpenCV DNN 4.6 imports DepthToSpace/Reshape only at the fixed size written in the file, so it runs "
            "fixed-size exports only; this is a --dynamic-size export (export again with a fixed --input size to run "
            "it in OpenCV DNN)";

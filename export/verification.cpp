@@ -55,21 +55,24 @@ NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch) {
   return export_inputs(export_signature(net.describe(false)), batch.lr_color, net.info_input(batch));
 }
 
-void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs) {
+void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,
+                       const ReferenceForward& forward) {
   const auto signature = export_signature(net.describe(false));
   check_inputs(signature, inputs);
   c.inputs.push_back(inputs);
-  c.expected.push_back(infer(net, find_tensor(inputs, kExportColorInput), info_tensor(signature, inputs)));
+  const torch::Tensor color = find_tensor(inputs, kExportColorInput), info = info_tensor(signature, inputs);
+  c.expected.push_back(forward ? forward(color, info) : infer(net, color, info));
 }
 
 VerifyCase make_verify_case(SRNetworkImpl& net, const ExportedModel& exported,
-                            const std::vector<std::pair<int64_t, int64_t>>& sizes, uint64_t seed) {
+                            const std::vector<std::pair<int64_t, int64_t>>& sizes, uint64_t seed,
+                            const ReferenceForward& forward) {
   VerifyCase c;
   c.label = spec_summary(net.spec());
   c.file = exported.file;
   c.format = exported.format;
   for (size_t i = 0; i < sizes.size(); ++i)
-    add_verify_inputs(c, net, random_inputs(exported.signature, sizes[i].first, sizes[i].second, seed + i));
+    add_verify_inputs(c, net, random_inputs(exported.signature, sizes[i].first, sizes[i].second, seed + i), forward);
   return c;
 }
 

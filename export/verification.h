@@ -14,6 +14,7 @@
 #include <torch/types.h>
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -37,16 +38,23 @@ struct VerifyCase {
   std::vector<torch::Tensor> expected;  // our forward pass on each input set
 };
 
-// Random inputs at each LR size (seeded) and our forward pass (models/inference.h infer) on them.
+// Our side of a comparison: the network's output for LR colour and rendering information.
+// Empty: the LibTorch forward pass (models/inference.h infer); an INT8 export compares with the
+// fused path's INT8 run instead.
+using ReferenceForward = std::function<torch::Tensor(const torch::Tensor& color, const torch::Tensor& info)>;
+
+// Random inputs at each LR size (seeded) and our forward pass on them.
 VerifyCase make_verify_case(SRNetworkImpl& net, const ExportedModel& exported,
-                            const std::vector<std::pair<int64_t, int64_t>>& sizes, uint64_t seed);
+                            const std::vector<std::pair<int64_t, int64_t>>& sizes, uint64_t seed,
+                            const ReferenceForward& forward = {});
 
 // The inputs an exported network takes for a rendered batch: lr_color and the model's own
 // rendering channels at the resolution it wants (SRNetworkImpl::info_input).
 NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch);
 
 // Adds an input set (e.g. a rendered frame) with our forward pass on it.
-void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs);
+void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,
+                       const ReferenceForward& forward = {});
 
 struct VerifyOptions {
   // Empty: every runtime of each file's format; one that cannot run a file (OpenCV DNN on a

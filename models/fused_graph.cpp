@@ -319,30 +319,15 @@ class Compiler {
   }
 
   // ---- precision ---------------------------------------------------------------------------------
-  // Which convolutions compute in the low format: all but the wide ones, which read a graph input
-  // or write a graph output through element-wise ops only (the first and last layers).
+  // Which convolutions compute in the low format (precision.h low_precision_convs).
   void choose_precisions() {
     low_ = options_.precision == Precision::Bf16   ? memory::data_type::bf16
            : options_.precision == Precision::Int8 ? kS8
                                                    : kF32;
-    const size_t values = g_.values.size(), ops = g_.ops.size();
-    conv_low_.assign(ops, false);
-    source_of_.assign(values, -1);
-    shadow_.assign(values, -1);
-    if (low_ == kF32) return;
-    std::vector<bool> from_input(values, false), to_output(values, false);
-    for (const auto& [name, v] : g_.inputs) from_input[v] = true;
-    for (const Op& op : g_.ops)
-      if (op.kind != OpKind::Conv)
-        for (int in : op.inputs) from_input[op.output] = from_input[op.output] || from_input[in];
-    for (const auto& [name, v] : g_.outputs) to_output[v] = true;
-    for (size_t i = ops; i-- > 0;)
-      if (g_.ops[i].kind != OpKind::Conv)
-        for (int in : g_.ops[i].inputs) to_output[in] = to_output[in] || to_output[g_.ops[i].output];
-    for (size_t i = 0; i < ops; ++i) {
-      const Op& op = g_.ops[i];
-      conv_low_[i] = op.kind == OpKind::Conv && !from_input[op.inputs[0]] && !to_output[op.output];
-    }
+    source_of_.assign(g_.values.size(), -1);
+    shadow_.assign(g_.values.size(), -1);
+    conv_low_ = low_precision_convs(g_);
+    if (low_ == kF32) conv_low_.assign(g_.ops.size(), false);
   }
 
   bool is_low_conv(int op) const { return g_.ops[op].kind == OpKind::Conv && conv_low_[op]; }

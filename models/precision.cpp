@@ -62,6 +62,49 @@ Calibration calibrate(const graph::Graph& graph,
   return c;
 }
 
+std::vector<bool> low_precision_convs(const graph::Graph& graph) {
+  const size_t values = graph.values.size(), ops = graph.ops.size();
+  std::vector<bool> from_input(values, false), to_output(values, false), low(ops, false);
+  for (const auto& [name, v] : graph.inputs) from_input[v] = true;
+  for (const auto& op : graph.ops)
+    if (op.kind != graph::OpKind::Conv)
+      for (int in : op.inputs) from_input[op.output] = from_input[op.output] || from_input[in];
+  for (const auto& [name, v] : graph.outputs) to_output[v] = true;
+  for (size_t i = ops; i-- > 0;)
+    if (graph.ops[i].kind != graph::OpKind::Conv)
+      for (int in : graph.ops[i].inputs) to_output[in] = to_output[in] || to_output[graph.ops[i].output];
+  for (size_t i = 0; i < ops; ++i) {
+    const auto& op = graph.ops[i];
+    low[i] = op.kind == graph::OpKind::Conv && !from_input[op.inputs[0]] && !to_output[op.output];
+  }
+  return low;
+}
+
+nlohmann::ordered_json calibration_json(const Calibration& c) {
+  nlohmann::ordered_json j;
+  j["method"] = enum_name(c.method);
+  j["frames"] = c.frames;
+  j["ranges"] = nlohmann::ordered_json::object();
+  for (const auto& [name, range] : c.ranges) j["ranges"][name] = range;
+  return j;
+}
+
+Calibration calibration_from_json(const nlohmann::json& j, const std::string& context) {
+  try {
+    Calibration c;
+    c.method = enum_from_name<CalibrationMethod>(j.at("method").get<std::string>());
+    c.frames = j.at("frames").get<int64_t>();
+    for (const auto& [name, range] : j.at("ranges").items()) {
+      const double r = range.get<double>();
+      if (!std::isfinite(r) || r < 0) throw Error(context, "calibration range of '" + name + "' is not a finite |x| bound");
+      c.ranges[name] = r;
+    }
+    return c;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(context, std::string("malformed calibration: ") + e.what());
+  }
+}
+
 float int8_scale(double range) {
   // A value that was always 0 still gets a positive step (every q is 0 then).
   return static_cast<float>(std::max(range, 1e-12) / 127.0);

@@ -13,6 +13,7 @@
 #include <torch/types.h>
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,6 +52,16 @@ struct Calibration {
   // The value's bound; Error naming the value when it was not calibrated.
   double range(const std::string& value) const;
 };
+
+// Which convolutions compute in a reduced precision (indexed like graph.ops; false for other
+// ops): all but the wide ones, which read a graph input (colour, depth spanning decades) or write
+// a graph output through element-wise ops only, i.e. the first and last layers. The fused path
+// and the quantized ONNX export both follow it.
+std::vector<bool> low_precision_convs(const graph::Graph& graph);
+
+// How a calibration is recorded in files (model metadata, results): method, frames, ranges.
+nlohmann::ordered_json calibration_json(const Calibration& c);
+Calibration calibration_from_json(const nlohmann::json& j, const std::string& context);
 
 // Runs `graph` in float32 (graph::run) on every input set in `frames` (each maps the graph's
 // input names to tensors, as FusedGraph::run takes them) and records the range of every op's

@@ -15,8 +15,11 @@
 #include "export/verification.h"
 #include "models/arch_spec.h"
 #include "models/complexity.h"
+#include "models/fused_graph.h"
 #include "models/model_source.h"
 #include "pruning/hybrid_model.h"
+#include "render_data/dataset.h"
+#include "render_data/patch_sampler.h"
 
 namespace cgsr {
 
@@ -33,10 +36,26 @@ config::Schema<ExportCommandOptions> export_schema() {
   s.field("verify", &ExportCommandOptions::verify, "verify the file in other runtimes against our forward pass");
   s.field("tolerance", &ExportCommandOptions::tolerance, "max abs error allowed by verify").range(0, 1);
   s.field("out", &ExportCommandOptions::out, "the file to write (a directory for a hybrid-pruned model)").required();
+  s.field("precision", &ExportCommandOptions::precision,
+          "fp32, or int8: ONNX with QuantizeLinear/DequantizeLinear around the convolutions, calibrated on data");
+  s.field("data", &ExportCommandOptions::data, "int8: data set whose rendered frames calibrate the activations");
+  s.section("calibration", &ExportCommandOptions::calibration, calibration_schema_fields(),
+            "int8: the frames activation ranges are measured on");
+  s.field("int8_tolerance", &ExportCommandOptions::int8_tolerance,
+          "int8: max abs error allowed by verify against the fused path's int8 output")
+      .range(0, 1);
+  const auto fp32 = [](const ExportCommandOptions& o) { return o.precision == Precision::Fp32; };
+  for (const char* key : {"precision", "data", "calibration", "int8_tolerance"}) s.omit_when(key, fp32);
   s.validate([](const ExportCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     parse_size(o.input, "input");
     if (o.dynamic_size && o.format != ExportFormat::Onnx)
       at.child("dynamic_size").fail(node, "only ONNX files have a fixed size; a TorchScript file takes any size");
+    if (o.precision == Precision::Bf16)
+      at.child("precision").fail(node, "bf16 is not exported: export fp32 and let the runtime convert");
+    if (o.precision == Precision::Int8 && o.format != ExportFormat::Onnx)
+      at.child("precision").fail(node, "int8 is exported as ONNX (format: onnx)");
+    if (o.precision == Precision::Int8 && o.data.empty())
+      at.child("data").fail(node, "int8 needs a data set to calibrate its activations on (--data DIR)");
   });
   add_run_settings(s);
   return s;
@@ -121,15 +140,24 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   o.dynamic_size = options.dynamic_size;
   o.cubic = options.cubic_resize;
   ModelSource source = resolve_model(options.model, options.scale);
-  if (source.provenance && is_hybrid_model(*source.provenance)) return run_hybrid_export(options, o);
+  if (source.provenance && is_hybrid_model(*source.provenance)) {
+    if (options.precision != Precision::Fp32) throw Error(options.model, "a hybrid-pruned model exports in fp32 only");
+    return run_hybrid_export(options, o);
+  }
   SRNetwork net = source.network;
   net->eval();
+  std::optional<Dataset> data;
+  if (options.precision == Precision::Int8) {
+    data = open_for_channels(options.data, net->input_channels());
+    o.int8 = calibrate_network(*net, *data, options.calibration);
+  }
   const ExportedModel exported = export_network(*net, options.out, o);
 
   nlohmann::ordered_json results;
   results["model"] = spec_summary(source.spec);
   results["file"] = exported.file.string();
   results["format"] = enum_name(exported.format);
+  results["precision"] = enum_name(options.precision);
   results["bytes"] = exported.bytes;
   results["dynamic_size"] = exported.dynamic_size;
   results["signature"] = exported.dynamic_size ? signature_string(exported.signature, w, h) + " (any size)"
@@ -154,11 +182,28 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   std::vector<std::pair<int64_t, int64_t>> sizes = {{w, h}};
   if (exported.dynamic_size) sizes.emplace_back(w / 2 + 3, h / 2 + 1);
   VerifyOptions v;
-  v.tolerance = options.tolerance;
+  v.tolerance = o.int8 ? options.int8_tolerance : options.tolerance;
   const uint64_t seed = make_rng("export-verify")();
-  const VerifyReport report = verify_exports({make_verify_case(*net, exported, sizes, seed)}, v);
+  // INT8 is compared with the fused path's INT8 run with the same calibration, on the random
+  // inputs and on a rendered frame (calibrated ranges fit rendered frames, not noise).
+  ReferenceForward forward;
+  if (o.int8) {
+    FusedGraph::Options fused;
+    fused.precision = Precision::Int8;
+    fused.calibration = *o.int8;
+    auto int8 = std::make_shared<FusedGraph>(net->describe(), fused);
+    forward = [int8](const torch::Tensor& color, const torch::Tensor& info) { return int8->run(color, info); };
+  }
+  VerifyCase c = make_verify_case(*net, exported, sizes, seed, forward);
+  if (data) {
+    const std::vector<int> frames = data->frames(Split::Test);
+    const int frame = frames.empty() ? 0 : frames.front();
+    const Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
+    if (b.lr_color.size(3) == w && b.lr_color.size(2) == h) add_verify_inputs(c, *net, inputs_from_batch(*net, b), forward);
+  }
+  const VerifyReport report = verify_exports({c}, v);
   results["verification"] = report.to_json();
-  report_verification(report, options.tolerance, exported.file.string());
+  report_verification(report, v.tolerance, exported.file.string());
   return results;
 }
 

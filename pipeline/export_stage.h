@@ -14,6 +14,7 @@
 #include <string>
 
 #include "export/export_format.h"
+#include "eval/calibration.h"
 #include "export/onnx_writer.h"
 #include "pipeline/run_settings.h"
 
@@ -29,6 +30,12 @@ struct ExportCommandOptions : RunSettings {
   bool verify = false;            // run the file in the other runtimes and compare with our forward
   double tolerance = 1e-4;        // max abs error allowed by --verify
   std::string out;                // the file to write
+  Precision precision = Precision::Fp32;  // int8: a quantized (QDQ) ONNX file, calibrated on `data`
+  std::string data;                       // int8: the rendered frames the activations are calibrated on
+  CalibrationOptions calibration;
+  // int8: --verify compares with the fused path's int8 run, whose convolutions keep their
+  // results in float32 until they are stored, where ONNX Runtime's round each to int8.
+  double int8_tolerance = 0.05;
 };
 
 config::Schema<ExportCommandOptions> export_schema();
