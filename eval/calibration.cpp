@@ -30,4 +30,24 @@ Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const Cal
   return calibrate(g, inputs, options.method);
 }
 
+std::string precision_row_name(const std::string& network, Precision precision) {
+  return precision == Precision::Fp32 ? network : network + " " + enum_name(precision);
+}
+
+std::string network_of_row(const std::string& row, Precision precision) {
+  const std::string suffix = precision_row_name("", precision);
+  if (row.size() < suffix.size() || row.compare(row.size() - suffix.size(), suffix.size(), suffix) != 0)
+    throw Error("report", "row '" + row + "' is not named as a network in " + enum_name(precision));
+  return row.substr(0, row.size() - suffix.size());
+}
+
+std::unique_ptr<NetworkUpscaler> network_in_precision(const NetworkUpscaler& network, Precision precision,
+                                                      const Dataset& data, const CalibrationOptions& options) {
+  FusedGraph::Options fused;
+  fused.precision = precision;
+  if (precision == Precision::Int8) fused.calibration = calibrate_network(*network.network(), data, options);
+  return std::make_unique<NetworkUpscaler>(precision_row_name(network.name(), precision), network.network(),
+                                           InferenceEngine::Fused, fused);
+}
+
 }  // namespace cgsr

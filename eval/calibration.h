@@ -2,7 +2,11 @@
 // INT8 calibration of a trained network on rendered frames (models/precision.h): which frames,
 // how many, and by which method, as configs and `cgsr eval` spell it.
 
+#include <memory>
+#include <string>
+
 #include "core/config.h"
+#include "eval/upscaler.h"
 #include "models/precision.h"
 #include "models/sr_network.h"
 #include "render_data/dataset.h"
@@ -19,5 +23,14 @@ config::Schema<CalibrationOptions> calibration_schema_fields();
 // The ranges of `net`'s activations on whole frames of `data` (LR colour and the rendering
 // information the network reads). Error naming the data set when the split has no frames.
 Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const CalibrationOptions& options);
+
+// A network's row name in a precision: "<network> int8" (fp32 keeps the network's name); and back.
+std::string precision_row_name(const std::string& network, Precision precision);
+std::string network_of_row(const std::string& row, Precision precision);
+
+// `network` on the fused path in `precision`, named by precision_row_name; INT8 calibrated on
+// `data` as `options` say.
+std::unique_ptr<NetworkUpscaler> network_in_precision(const NetworkUpscaler& network, Precision precision,
+                                                      const Dataset& data, const CalibrationOptions& options);
 
 }  // namespace cgsr

@@ -169,6 +169,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
                     const std::function<void(const EvalResult&)>& on_quality) {
   EvalResult result;
   result.name = upscaler.name();
+  result.precision = upscaler.precision();
   result.dataset = data.info().name;
   result.split = options.split;
   result.scale = upscaler.scale();
@@ -375,6 +376,7 @@ std::string csv_psnr(std::optional<double> value) {
 nlohmann::ordered_json to_json(const EvalResult& r) {
   nlohmann::ordered_json j;
   j["name"] = r.name;
+  if (r.precision != Precision::Fp32) j["precision"] = enum_name(r.precision);
   j["dataset"] = r.dataset;
   j["split"] = r.split;
   j["scale"] = r.scale;
@@ -420,6 +422,7 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
   try {
     EvalResult r;
     r.name = j.at("name");
+    if (j.contains("precision")) r.precision = enum_from_name<Precision>(j.at("precision").get<std::string>());
     r.dataset = j.at("dataset");
     r.split = j.at("split");
     r.scale = j.at("scale");

@@ -48,6 +48,7 @@ struct FrameScore {
 
 struct EvalResult {
   std::string name;
+  Precision precision = Precision::Fp32;  // of a network's row ("<network> int8")
   std::string dataset;  // the data set's scene name
   std::string split;
   int scale = 2;

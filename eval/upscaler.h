@@ -54,6 +54,8 @@ class Upscaler {
   // The pattern the last upscale() chose, for the per-frame record; none for upscalers that
   // choose nothing.
   virtual std::optional<PatternChoice> frame_choice() const { return std::nullopt; }
+  // The number format its network computes in (models/precision.h).
+  virtual Precision precision() const { return Precision::Fp32; }
 };
 
 // nearest, bilinear, bicubic, lanczos, fsr
@@ -74,6 +76,7 @@ class NetworkUpscaler : public Upscaler {
   torch::Tensor upscale(const Batch& batch) override;
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   SRNetwork network() const { return network_; }
+  Precision precision() const override { return fused_options_.precision; }
 
  private:
   std::string name_;

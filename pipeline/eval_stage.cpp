@@ -81,13 +81,7 @@ std::vector<std::unique_ptr<Upscaler>> in_precisions(std::vector<std::unique_ptr
       out.push_back(std::move(u));
       continue;
     }
-    for (Precision p : precisions) {
-      FusedGraph::Options fused;
-      fused.precision = p;
-      if (p == Precision::Int8) fused.calibration = calibrate_network(*network->network(), data, calibration);
-      const std::string name = p == Precision::Fp32 ? network->name() : network->name() + " " + enum_name(p);
-      out.push_back(std::make_unique<NetworkUpscaler>(name, network->network(), InferenceEngine::Fused, fused));
-    }
+    for (Precision p : precisions) out.push_back(network_in_precision(*network, p, data, calibration));
   }
   return out;
 }

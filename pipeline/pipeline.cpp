@@ -70,6 +70,12 @@ config::Schema<PipelineOptions> pipeline_schema() {
             "the CG-enhanced network cut to the CG-optimized network's latency, fine-tuned alike");
   s.field("export_formats", &PipelineOptions::export_formats, "formats the final networks are exported to and verified in (onnx, torchscript)");
   s.block("eval", &PipelineOptions::eval, "held-out evaluation options (split, frames; latency_runs: rounds of the report's side-by-side timing)");
+  s.field("precisions", &PipelineOptions::precisions,
+          "number formats the evaluated networks run in (fp32, bf16, int8), each a row of the report")
+      .check([](const auto& v) { return std::find(v.begin(), v.end(), Precision::Fp32) != v.end(); },
+             "must include fp32 (the stages' own figures are float32)");
+  s.section("calibration", &PipelineOptions::calibration, calibration_schema_fields(),
+            "the training frames int8 rows are calibrated on");
   s.section("heldout", &PipelineOptions::heldout, heldout_schema(),
             "scenes not in the training data, on which every model and classic baseline is evaluated");
   s.section("images", &PipelineOptions::images, comparison_schema_fields(),
@@ -194,6 +200,22 @@ const EvalResult* find_result(const std::vector<EvalResult>& results, const std:
 }  // namespace
 
 namespace {
+// One row per network and data set: a later stage's row replaces an earlier one of the same name
+// (the eval stage evaluates the CG-optimized network for its other formats; the prune stage's
+// float32 row of it is the one the report keeps).
+std::vector<EvalResult> without_repeated_rows(std::vector<EvalResult> rows) {
+  std::vector<EvalResult> out;
+  for (auto& r : rows) {
+    const auto same = std::find_if(out.begin(), out.end(),
+                                   [&](const EvalResult& o) { return o.name == r.name && o.dataset == r.dataset; });
+    if (same != out.end())
+      *same = std::move(r);
+    else
+      out.push_back(std::move(r));
+  }
+  return out;
+}
+
 // ONNX Runtime's latency for every row with an exported file, on the frame the side-by-side
 // timing used (the exported file takes the same inputs: lr_color, lr_render_info).
 void time_in_onnxruntime(std::vector<EvalResult>& evaluations, const std::map<std::string, fs::path>& onnx_files,
@@ -511,6 +533,15 @@ class Pipeline {
               model == pruned_file ? fs::path(e.out) / pattern_file_name(0, format) : fs::path(e.out);
         exports.push_back(e);
         export_config.push_back(export_schema().emit(e));
+        if (!onnx || model == pruned_file || !in_precision(Precision::Int8)) continue;
+        // The same network quantized, for the int8 rows' ONNX Runtime column.
+        e.precision = Precision::Int8;
+        e.data = data_path_;
+        e.calibration = options_.calibration;
+        e.out = (stages_.dir("export") / (stem + "_int8.onnx")).string();
+        int8_onnx_of_file_[model.string()] = e.out;
+        exports.push_back(e);
+        export_config.push_back(export_schema().emit(e));
       }
     }
     exported_ = stages_.run("export", export_config,
@@ -537,6 +568,10 @@ class Pipeline {
     for (const std::string stage : {"train", "control", "enhance", "elastic"})
       evaluation.models.push_back(model_file(stage).string());
     for (const auto& extra : control_models()) evaluation.models.push_back(extra.file.string());
+    evaluation.precisions = options_.precisions;
+    evaluation.calibration = options_.calibration;
+    // The CG-optimized network's float32 row is the prune stage's; here its other formats.
+    if (options_.precisions.size() > 1) evaluation.models.push_back(model_file("search").string());
     evaluated_ = stages_.run("eval", eval_schema().emit(evaluation),
                              {data_hash_, trained_.hash, control_stage_.hash, enhanced_stage_.hash, elastic_stage_.hash,
                               scratched_.hash, controlled_.hash},
@@ -576,6 +611,10 @@ class Pipeline {
     return out;
   }
 
+  bool in_precision(Precision p) const {
+    return std::find(options_.precisions.begin(), options_.precisions.end(), p) != options_.precisions.end();
+  }
+
   std::vector<std::string> classic_models() const {
     std::vector<std::string> models = {"bicubic"};
     for (const auto& b : options_.baselines)
@@ -599,7 +638,7 @@ class Pipeline {
     config["runs"] = report_runs;
     config["images"] = comparison_schema_fields().emit(options_.images);
     const auto reported = stages_.run("report", config, upstream, [&](RunDir& dir, bool) {
-      std::vector<EvalResult> evaluations = collect_evaluations(runs);
+      std::vector<EvalResult> evaluations = without_repeated_rows(collect_evaluations(runs));
       const auto upscalers = report_upscalers(evaluations);
       if (eval_.latency_runs > 0) time_side_by_side(evaluations, upscalers);
       const std::vector<EvalResult> unseen = collect_evaluations(heldout_runs);
@@ -630,6 +669,13 @@ class Pipeline {
     const auto files = model_files();
     std::vector<std::unique_ptr<Upscaler>> upscalers;
     for (const auto& e : evaluations) {
+      if (e.precision != Precision::Fp32) {
+        const std::string network = network_of_row(e.name, e.precision);
+        const auto base = make_upscaler(files.at(network).string(), network, backbone_.scale);
+        upscalers.push_back(network_in_precision(dynamic_cast<const NetworkUpscaler&>(*base), e.precision, *data_,
+                                                 options_.calibration));
+        continue;
+      }
       const auto file = files.find(e.name);
       if (e.name == roles_.static_network.name)
         upscalers.push_back(std::make_unique<NetworkUpscaler>(e.name, load_model(model_file("prune")).network));
@@ -691,6 +737,8 @@ class Pipeline {
     for (const auto& [name, file] : files) {
       const auto onnx = onnx_of_file_.find(file.string());
       if (onnx != onnx_of_file_.end() && name != roles_.hybrid.name) onnx_files[name] = onnx->second;
+      const auto int8 = int8_onnx_of_file_.find(file.string());
+      if (int8 != int8_onnx_of_file_.end()) onnx_files[precision_row_name(name, Precision::Int8)] = int8->second;
     }
     std::vector<TimingSequence> sequences;  // per model, test frames timed in turn
     std::vector<Batch> frames;              // per model, the first of them
@@ -776,7 +824,8 @@ class Pipeline {
       exported_, evaluated_, heldout_;
   PruneRoles roles_;
   std::vector<PrunedModel> controls_;  // the controls of equal latency
-  std::map<std::string, fs::path> onnx_of_file_;  // model file -> its exported ONNX file
+  std::map<std::string, fs::path> onnx_of_file_;       // model file -> its exported ONNX file
+  std::map<std::string, fs::path> int8_onnx_of_file_;  // model file -> its QDQ export (int8 rows)
   std::vector<EvalResult> own_, unseen_;          // the report's rows: the run's data set, held-out scenes
 };
 

@@ -39,6 +39,7 @@
 #include "export/export_format.h"
 #include "pipeline/controls_stage.h"
 #include "pipeline/heldout_evaluation.h"
+#include "eval/calibration.h"
 #include "pipeline/run_settings.h"
 #include "pipeline/verdict.h"
 
@@ -62,6 +63,10 @@ struct PipelineOptions : RunSettings {
   ControlsOptions controls;
   std::vector<ExportFormat> export_formats = {ExportFormat::Onnx, ExportFormat::TorchScript};
   config::Block eval;                // EvalOptions shared by the eval and prune stages
+  // The eval stage's networks and the CG-optimized one in each number format (fused engine);
+  // int8 rows are calibrated as `calibration` says and exported as QDQ ONNX files.
+  std::vector<Precision> precisions = {Precision::Fp32};
+  CalibrationOptions calibration;
   HeldoutOptions heldout;            // scenes never trained on, evaluated with every model
   ComparisonOptions images;          // crops and error maps in the report
   VerdictOptions verdict;

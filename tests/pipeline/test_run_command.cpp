@@ -177,6 +177,26 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   expect_actions(run_cgsr(args + " --from eval"),
                  {{"prune", "skipped"}, {"export", "skipped"}, {"eval", "ran"}, {"heldout", "ran"}, {"report", "ran"}});
 
+  // In int8 as well: the evaluated networks and the CG-optimized one get int8 rows, timed side by
+  // side and in ONNX Runtime from their QDQ exports; the float32 rows stay the stages' own.
+  const CliResult int8 = run_cgsr(args + " --set \"precisions=[fp32, int8]\" --set calibration.frames=2");
+  expect_actions(int8, {{"prune", "skipped"}, {"export", "ran"}, {"eval", "ran"}, {"report", "ran"}});
+  EXPECT_TRUE(fs::exists(out / "export" / "cg_optimized_int8.onnx"));
+  std::map<std::string, int> rows;
+  const auto reported = read_json(out / "report" / "results.json");
+  for (const auto& e : reported["evaluations"]) {
+    if (e["dataset"] != "tiny") continue;
+    const std::string name = e["name"];
+    ++rows[name];
+    if (name == "PAN x2 int8" || name == "CG-optimized PAN x2 int8") {
+      EXPECT_EQ(e["precision"], "int8");
+      EXPECT_TRUE(e.contains("onnxruntime_latency_ms")) << name;
+      EXPECT_TRUE(e.contains("latency_ms")) << name;
+    }
+  }
+  for (const std::string name : {"PAN x2 int8", "CG-optimized PAN x2 int8", "CG-enhanced PAN x2 int8", "CG-optimized PAN x2"})
+    EXPECT_EQ(rows[name], 1) << name;
+
   // A held-out scene that is the training scene is an error naming its config.
   const std::string tiny = std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml";
   const CliResult same = run_cgsr(args + " --set \"heldout.scenes=[" + tiny + "]\"");
