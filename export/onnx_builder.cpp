@@ -125,14 +125,16 @@ std::string OnnxBuilder::int64_initializer(const std::string& name, const std::v
 std::string OnnxBuilder::integer_initializer(const std::string& name, const torch::Tensor& value,
                                              const std::vector<int64_t>& shape) {
   const auto t = value.detach().to(torch::kCPU).contiguous();
-  CGSR_CHECK(t.scalar_type() == torch::kChar || t.scalar_type() == torch::kInt,
-             "onnx export: integer initializer '" + name + "' must be int8 or int32");
+  CGSR_CHECK(t.scalar_type() == torch::kChar || t.scalar_type() == torch::kByte || t.scalar_type() == torch::kInt,
+             "onnx export: integer initializer '" + name + "' must be int8, uint8 or int32");
   int64_t count = 1;
   for (auto d : shape) count *= d;
   CGSR_CHECK(t.numel() == count, "onnx export: initializer '" + name + "' has the wrong number of values");
   auto* init = g_->add_initializer();
   init->set_name(claim(name));
-  init->set_data_type(t.scalar_type() == torch::kChar ? onnx::TensorProto::INT8 : onnx::TensorProto::INT32);
+  init->set_data_type(t.scalar_type() == torch::kChar   ? onnx::TensorProto::INT8
+                      : t.scalar_type() == torch::kByte ? onnx::TensorProto::UINT8
+                                                        : onnx::TensorProto::INT32);
   for (auto d : shape) init->add_dims(d);
   init->set_raw_data(t.data_ptr(), static_cast<size_t>(t.numel() * t.element_size()));
   return name;

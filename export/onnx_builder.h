@@ -52,7 +52,7 @@ class OnnxBuilder {
   std::string initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape);
   std::string float_initializer(const std::string& name, const std::vector<float>& values);  // 1-D
   std::string int64_initializer(const std::string& name, const std::vector<int64_t>& values);  // 1-D
-  // INT8 or INT32 initializer of `shape` from an int8 (kChar) or int32 (kInt) tensor, as stored.
+  // INT8, UINT8 or INT32 initializer of `shape` from a kChar, kByte or kInt tensor, as stored.
   std::string integer_initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape);
 
   // Serialized and checked (check_onnx_bytes); errors name `context`.

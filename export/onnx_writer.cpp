@@ -187,8 +187,10 @@ class Writer {
 
   std::string quantize_dequantize(const std::string& base, const std::string& x, float step,
                                   const std::string& out = "") {
+    // uint8 with zero point 128 holds the same symmetric values as int8 (q + 128), and is what
+    // ONNX Runtime's x86 int8 kernels take for activations.
     const std::string scale = initializer(base + ".int8_step", torch::tensor(step), {});
-    const std::string zero = b_.integer_initializer(base + ".int8_zero", torch::zeros({}, torch::kChar), {});
+    const std::string zero = b_.integer_initializer(base + ".int8_zero", torch::full({}, 128, torch::kByte), {});
     const std::string q = claim(base + ".int8");
     node("QuantizeLinear", base + ".quantize", {x, scale, zero}, {q});
     const std::string y = out.empty() ? claim(base + ".dequantized") : out;

@@ -49,10 +49,10 @@ struct OnnxOptions {
   std::string model_name = "cgsr";                              // graph name
   std::vector<std::pair<std::string, std::string>> metadata;  // metadata_props, e.g. {"cgsr.spec", yaml}
   // INT8 as QDQ: each convolution low_precision_convs() picks reads its input through a
-  // QuantizeLinear/DequantizeLinear pair (the calibrated step, zero point 0), its weight as int8
-  // per output channel and its bias as int32 through DequantizeLinear, and its result passes a
-  // pair of its own (the step of its calibrated output), so ONNX Runtime runs it as an int8
-  // convolution. Empty: float32.
+  // QuantizeLinear/DequantizeLinear pair (the calibrated step; uint8 with zero point 128, the same
+  // symmetric values), its weight as int8 per output channel and its bias as int32 through
+  // DequantizeLinear, and its result passes a pair of its own (the step of its calibrated
+  // output), so ONNX Runtime runs it as an int8 convolution. Empty: float32.
   std::optional<Calibration> int8;
 };
 
