@@ -984,7 +984,7 @@ class Compiler {
   std::vector<bool> conv_low_;    // per op: a convolution computing in low_
   std::vector<int> shadow_;       // per value: its converted copy, or -1
   std::vector<int> source_of_;    // per value: what a converted copy was made from (-1: none)
-  std::pair<int, memory::desc> committed_md_{-1, {}};  // the destination a conv plan stores in low_
+  std::pair<int, memory::desc> committed_md_{-1, {}};  // a conv plan's destination, applied if the plan is kept
   std::vector<int> buffer_of_;
   std::vector<Call*> scratch_calls_;
 };
