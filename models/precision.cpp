@@ -29,16 +29,19 @@ double Calibration::range(const std::string& value) const {
 namespace {
 
 constexpr double kPercentile = 0.9999;
-constexpr int64_t kPercentileSamples = int64_t{1} << 20;
+constexpr int64_t kPercentileBins = 1 << 14;
 
 double bound(const torch::Tensor& y, CalibrationMethod method) {
-  torch::Tensor a = y.detach().abs().flatten();
-  if (method == CalibrationMethod::Max || a.numel() < 2) return a.max().item<double>();
-  // A selection over every element of an HR activation takes seconds; an evenly strided sample of
-  // about a million elements (deterministic) puts a hundred values above the percentile.
-  if (a.numel() > 2 * kPercentileSamples) a = a.slice(0, 0, a.numel(), a.numel() / kPercentileSamples).contiguous();
-  const int64_t k = std::clamp<int64_t>(static_cast<int64_t>(std::ceil(kPercentile * a.numel())), 1, a.numel());
-  return std::get<0>(a.kthvalue(k)).item<double>();
+  const torch::Tensor a = y.detach().abs().flatten().to(torch::kFloat);
+  const double largest = a.max().item<double>();
+  if (method == CalibrationMethod::Max || largest == 0) return largest;
+  // From a histogram of |x| over [0, max]: the upper edge of the bin the percentile falls in (a
+  // bound within max / 16384 of it). Selecting it exactly (kthvalue, topk) over every element of
+  // each HR activation took minutes per network.
+  const torch::Tensor cumulative = torch::histc(a, kPercentileBins, 0, largest).to(torch::kDouble).cumsum(0);
+  const double k = std::ceil(kPercentile * static_cast<double>(a.numel()));
+  const int64_t bin = (cumulative < k).sum().item<int64_t>();
+  return largest * static_cast<double>(std::min(bin + 1, kPercentileBins)) / kPercentileBins;
 }
 
 }  // namespace
