@@ -10,7 +10,7 @@ config::Schema<CalibrationOptions> calibration_schema_fields() {
   config::Schema<CalibrationOptions> s;
   s.field("split", &CalibrationOptions::split, "split the frames come from").one_of({"train", "val", "test", "all"});
   s.field("frames", &CalibrationOptions::frames, "frames measured, spread evenly over the split").range(1, 1000);
-  s.field("method", &CalibrationOptions::method, "range of each activation: max, or percentile (99.99th of |x|)");
+  s.field("method", &CalibrationOptions::method, "range of each activation: percentile (99.99th of |x|) or max");
   return s;
 }
 

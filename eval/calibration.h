@@ -16,7 +16,9 @@ namespace cgsr {
 struct CalibrationOptions {
   std::string split = "train";  // frames the evaluation does not score
   int frames = 16;              // spread evenly over the split
-  CalibrationMethod method = CalibrationMethod::Max;
+  // The percentile lost a third to a half of max's 0.03-0.07 dB on the quickstart's networks
+  // (docs/results/precision.md).
+  CalibrationMethod method = CalibrationMethod::Percentile;
 };
 config::Schema<CalibrationOptions> calibration_schema_fields();
 

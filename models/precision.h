@@ -7,7 +7,7 @@
 // convolution's weight (that channel's max |w| / 127). The graph's values are measured in
 // float32 on calibration frames (rendered training frames), by the method below.
 //
-//   Calibration c = calibrate(graph, frames, CalibrationMethod::Max);
+//   Calibration c = calibrate(graph, frames, CalibrationMethod::Percentile);
 //   FusedGraph fast(graph, {.precision = Precision::Int8, .calibration = c});
 
 #include <torch/types.h>
@@ -36,7 +36,8 @@ struct EnumNames<Precision> {
 
 enum class CalibrationMethod {
   Max,         // the largest |x| seen: nothing saturates, small values get coarse steps
-  Percentile,  // the 99.99th percentile of |x| per frame, the largest over frames: outliers saturate
+  Percentile,  // the 99.99th percentile of |x| per frame (from a histogram, within max / 16384),
+               // the largest over frames: outliers saturate
 };
 template <>
 struct EnumNames<CalibrationMethod> {

@@ -570,11 +570,14 @@ class Pipeline {
     for (const auto& extra : control_models()) evaluation.models.push_back(extra.file.string());
     evaluation.precisions = options_.precisions;
     evaluation.calibration = options_.calibration;
+    std::vector<std::string> upstream = {data_hash_,          trained_.hash,   control_stage_.hash, enhanced_stage_.hash,
+                                         elastic_stage_.hash, scratched_.hash, controlled_.hash};
     // The CG-optimized network's float32 row is the prune stage's; here its other formats.
-    if (options_.precisions.size() > 1) evaluation.models.push_back(model_file("search").string());
-    evaluated_ = stages_.run("eval", eval_schema().emit(evaluation),
-                             {data_hash_, trained_.hash, control_stage_.hash, enhanced_stage_.hash, elastic_stage_.hash,
-                              scratched_.hash, controlled_.hash},
+    if (options_.precisions.size() > 1) {
+      evaluation.models.push_back(model_file("search").string());
+      upstream.push_back(searched_.hash);
+    }
+    evaluated_ = stages_.run("eval", eval_schema().emit(evaluation), upstream,
                              [&](RunDir& dir, bool) { return run_eval(evaluation, &dir); });
     record("eval", evaluated_);
   }
