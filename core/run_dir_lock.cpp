@@ -21,14 +21,15 @@ struct Holder {
   std::string command;
 };
 
-// "<pid> <command>" as the last holder wrote it; empty for a new file.
+// "<pid> <command>" as the last holder wrote it; empty for a new file. The command is the rest
+// of the line: "data merge" is two words.
 Holder read_holder(int fd) {
   std::string text(256, '\0');
   const ssize_t n = ::pread(fd, text.data(), text.size(), 0);
   text.resize(n > 0 ? static_cast<size_t>(n) : 0);
   Holder h;
   std::istringstream in(text);
-  in >> h.pid >> h.command;
+  if (in >> h.pid) std::getline(in >> std::ws, h.command);
   return h;
 }
 }  // namespace

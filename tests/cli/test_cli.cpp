@@ -131,6 +131,15 @@ TEST(Cli, ARunDirectoryOfAnotherCommandIsRefusedUnlessForced) {
   r = run_cgsr(render + " --force");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(cgsr::read_file(dir / ".cgsr.lock").find(" render"), std::string::npos);
+
+  // A command of two words is one command: it may rerun in its directory, and is named whole.
+  const auto two = scratch_dir("cli-kind-two");
+  const std::string check = "data check " + (two / "no-data").string() + " --out " + (two / "run").string();
+  ASSERT_EQ(run_cgsr(check).exit_code, 2);  // no data set there; the directory is data check's now
+  r = run_cgsr(check);
+  EXPECT_EQ(r.err.find("belongs to"), std::string::npos) << r.err;
+  r = run_cgsr("info --out " + (two / "run").string());
+  EXPECT_NE(r.err.find("belongs to 'cgsr data check' (.cgsr.lock)"), std::string::npos) << r.err;
 }
 
 // A non-UTF-8 --out used to pass every check and fail at the very end (exit 1, json type_error
