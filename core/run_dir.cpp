@@ -25,12 +25,16 @@ void RunDir::write_config(const YAML::Node& resolved) const {
   write_file_atomic(file("config.yaml"), config::to_yaml(resolved));
 }
 
-void RunDir::write_results(const nlohmann::ordered_json& results) const {
+void RunDir::write_results(const nlohmann::ordered_json& results) {
   // Inputs are checked for UTF-8 before a command starts (core/utf8.h); a name read from disk
   // that is not still must not cost the results at the very end, so it is replaced, not thrown.
   write_file_atomic(file("results.json"),
                     results.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n");
+  for (const auto& step : after_results_) step();
+  after_results_.clear();
 }
+
+void RunDir::after_results(std::function<void()> step) { after_results_.push_back(std::move(step)); }
 
 std::filesystem::path default_run_dir(const std::string& command) {
   const std::time_t now = std::time(nullptr);

@@ -5,8 +5,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace cgsr {
 
@@ -23,11 +25,16 @@ class RunDir {
   std::filesystem::path file(const std::string& name) const { return dir_ / name; }
 
   void write_config(const YAML::Node& resolved) const;
-  void write_results(const nlohmann::ordered_json& results) const;
+  // Writes results.json, then runs the steps given to after_results.
+  void write_results(const nlohmann::ordered_json& results);
+  // `step` runs right after results.json is written: for what must not look finished before
+  // the results do (a rendered data set's manifest marked complete).
+  void after_results(std::function<void()> step);
 
  private:
   std::filesystem::path dir_;
   bool own_log_;
+  std::vector<std::function<void()>> after_results_;
 };
 
 // "runs/<command>-YYYYmmdd-HHMMSS": the default --out of a command that produces artifacts.

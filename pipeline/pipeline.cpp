@@ -407,7 +407,7 @@ class Pipeline {
   void render() {
     if (rendering_) {
       const auto o = stages_.run("render", render_schema().emit(scene_), {}, [&](RunDir& dir, bool) {
-        return run_render(scene_, dir.path());
+        return run_render(scene_, dir);
       });
       record("render", o);
       data_hash_ = o.hash;

@@ -100,7 +100,13 @@ nlohmann::ordered_json render_summary(const std::filesystem::path& out, const Da
   return j;
 }
 
-nlohmann::ordered_json run_scene_set(const RenderOptions& options, const std::filesystem::path& out) {
+// A render's results and its manifest, which finish_render marks complete.
+struct Rendered {
+  nlohmann::ordered_json summary;
+  DatasetManifest manifest;
+};
+
+Rendered render_scene_set(const RenderOptions& options, const std::filesystem::path& out) {
   const auto jobs = scene_set_jobs(options);
   int total = 0;
   for (const auto& job : jobs) total += job.options.frames;
@@ -130,7 +136,27 @@ nlohmann::ordered_json run_scene_set(const RenderOptions& options, const std::fi
                 entry.first_frame, entry.first_frame + entry.frames - 1, s.manifest.split.train.size(),
                 s.manifest.split.val.size(), s.manifest.split.test.size(), sizes.c_str());
   }
-  return j;
+  return {j, r.manifest};
+}
+
+Rendered render_one_scene(const RenderOptions& options, const std::filesystem::path& out) {
+  Progress progress("render", options.frames);
+  const RenderJobResult r = run_render_job(options, static_cast<uint64_t>(options.seed), out,
+                                           [&progress](int, int) { progress.advance(); });
+  progress.finish();
+  nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
+  j["triangles"] = r.triangles;
+  j["bytes_per_frame"] = sizes_json(r);
+  std::printf("rendered %d frame(s) (%d resumed) of '%s' into %s in %.1f s\n", r.rendered, r.skipped,
+              r.manifest.name.c_str(), out.string().c_str(), r.seconds);
+  for (size_t i = 0; i < r.manifest.resolutions.size(); ++i)
+    std::printf("  %-10s %s per frame\n", r.manifest.resolutions[i].name().c_str(),
+                human_bytes(r.manifest.bytes_per_frame[i]).c_str());
+  return {j, r.manifest};
+}
+
+Rendered render(const RenderOptions& options, const std::filesystem::path& out) {
+  return options.scenes.empty() ? render_one_scene(options, out) : render_scene_set(options, out);
 }
 }  // namespace
 
@@ -153,20 +179,15 @@ std::string check_render(const RenderOptions& options) {
 }
 
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out) {
-  if (!options.scenes.empty()) return run_scene_set(options, out);
-  Progress progress("render", options.frames);
-  const RenderJobResult r = run_render_job(options, static_cast<uint64_t>(options.seed), out,
-                                           [&progress](int, int) { progress.advance(); });
-  progress.finish();
-  nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
-  j["triangles"] = r.triangles;
-  j["bytes_per_frame"] = sizes_json(r);
-  std::printf("rendered %d frame(s) (%d resumed) of '%s' into %s in %.1f s\n", r.rendered, r.skipped,
-              r.manifest.name.c_str(), out.string().c_str(), r.seconds);
-  for (size_t i = 0; i < r.manifest.resolutions.size(); ++i)
-    std::printf("  %-10s %s per frame\n", r.manifest.resolutions[i].name().c_str(),
-                human_bytes(r.manifest.bytes_per_frame[i]).c_str());
-  return j;
+  Rendered r = render(options, out);
+  finish_render(out, r.manifest);
+  return r.summary;
+}
+
+nlohmann::ordered_json run_render(const RenderOptions& options, RunDir& run_dir) {
+  Rendered r = render(options, run_dir.path());
+  run_dir.after_results([out = run_dir.path(), manifest = r.manifest] { finish_render(out, manifest); });
+  return r.summary;
 }
 
 }  // namespace cgsr

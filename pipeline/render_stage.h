@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/run_dir.h"
 #include "pipeline/run_settings.h"
 #include "render_data/render_job.h"
 
@@ -40,7 +41,12 @@ struct RenderOptions : RunSettings, RenderJobOptions {
 config::Schema<RenderOptions> render_schema();
 // The scene set's entries as render jobs, each parsed from its config file with its overrides.
 std::vector<SceneRenderJob> scene_set_jobs(const RenderOptions& options);
+// Renders into `out` and marks the data set complete: for a caller that writes nothing more there.
 nlohmann::ordered_json run_render(const RenderOptions& options, const std::filesystem::path& out);
+// Renders into a run directory (`cgsr render`, the render stage of `cgsr run`), whose manifest is
+// marked complete only once its results.json is written: a data set never looks finished before
+// its run directory is.
+nlohmann::ordered_json run_render(const RenderOptions& options, RunDir& run_dir);
 // What `cgsr render --check` does beyond the schema: the checks the run makes before its first
 // frame (resolutions, and each scene built from its block, which parses the source's options),
 // so a config --check passes is not rejected by the run. Returns a line per scene.

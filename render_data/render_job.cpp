@@ -125,8 +125,7 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
     for (auto& b : result.bytes_per_kind[ri]) total += (b /= o.frames);
     m.bytes_per_frame.push_back(total);
   }
-  m.complete = true;
-  write_manifest(out, m);
+  write_manifest(out, m);  // with the sizes, still complete: false (finish_render)
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (result.skipped > 0) spdlog::info("resumed: {} frame(s) were already complete", result.skipped);
   for (size_t ri = 0; ri < resolutions.size(); ++ri) {
@@ -181,16 +180,21 @@ SceneSetRenderResult run_scene_set_render(const std::string& name, const std::ve
   int done = 0;
   for (const auto& job : jobs) {
     spdlog::info("scene {}/{}: '{}' ({})", result.scenes.size() + 1, jobs.size(), job.options.name, job.origin);
-    result.scenes.push_back(run_render_job(job.options, seed, out / "scenes" / job.options.name, [&](int, int) {
+    const fs::path scene_dir = out / "scenes" / job.options.name;
+    result.scenes.push_back(run_render_job(job.options, seed, scene_dir, [&](int, int) {
       if (progress) progress(++done, total);
     }));
+    finish_render(scene_dir, result.scenes.back().manifest);  // nothing else is written into a scene's directory
     result.rendered += result.scenes.back().rendered;
     result.skipped += result.scenes.back().skipped;
   }
-  m.complete = true;
-  write_manifest(out, m);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
+}
+
+void finish_render(const fs::path& out, DatasetManifest manifest) {
+  manifest.complete = true;
+  write_manifest(out, manifest);
 }
 
 }  // namespace cgsr

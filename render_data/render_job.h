@@ -71,6 +71,8 @@ struct RenderJobResult {
 };
 
 // Renders into `out` (created if needed). `progress` is called after each frame (done, total).
+// The manifest stays `complete: false`: the caller writes whatever else belongs in `out`, then
+// calls finish_render, so a data set never looks complete before all of it is written.
 RenderJobResult run_render_job(const RenderJobOptions& options, uint64_t seed, const std::filesystem::path& out,
                                const std::function<void(int, int)>& progress = {});
 
@@ -92,13 +94,16 @@ struct SceneSetRenderResult {
 };
 
 // Renders every scene into `out`/scenes/<name> (each a single-scene data set that resumes as
-// run_render_job does; every scene with `seed`) and writes the set's manifest into `out`:
-// complete: false first, true when every scene is. The scenes need the same resolutions; a
-// directory holding a set of other scenes or configurations is an error. `progress` counts the
-// frames of all scenes. `name` empty: the scene names joined by '+'.
+// run_render_job does, marked complete when its frames are; every scene with `seed`) and writes
+// the set's manifest into `out`, `complete: false` until finish_render. The scenes need the
+// same resolutions; a directory holding a set of other scenes or configurations is an error.
+// `progress` counts the frames of all scenes. `name` empty: the scene names joined by '+'.
 SceneSetRenderResult run_scene_set_render(const std::string& name, const std::vector<SceneRenderJob>& jobs,
                                           uint64_t seed, const std::filesystem::path& out,
                                           const std::function<void(int, int)>& progress = {});
+
+// The last step of a render: `manifest` (a result's) written into `out` as complete.
+void finish_render(const std::filesystem::path& out, DatasetManifest manifest);
 
 // "1.2 MB", "340 KB": for size reports.
 std::string human_bytes(double bytes);

@@ -33,15 +33,17 @@ void setup_data_merge(CLI::App& data) {
         list_to_key(sub, flags, "data", "data", "data set directories", "DATA");
       },
       [](const DataMergeOptions& options, const YAML::Node&, RunDir* run_dir) {
-        return run_data_merge(options, run_dir->path());
+        return run_data_merge(options, *run_dir);
       },
       /*always_run_dir=*/true);
 }
 
-nlohmann::ordered_json run_data_merge(const DataMergeOptions& options, const std::filesystem::path& out) {
+nlohmann::ordered_json run_data_merge(const DataMergeOptions& options, RunDir& run_dir) {
+  const std::filesystem::path& out = run_dir.path();
   std::vector<std::filesystem::path> dirs(options.data.begin(), options.data.end());
   const DatasetManifest m = merge_manifests(out, options.name, dirs, options.weights);
-  write_manifest(out, m);
+  // The manifest makes the directory a data set: written last, so a failed merge leaves none.
+  run_dir.after_results([out, m] { write_manifest(out, m); });
   nlohmann::ordered_json j;
   j["dataset"] = out.string();
   j["name"] = m.name;

@@ -18,6 +18,7 @@ struct DataMergeOptions : RunSettings {
 
 config::Schema<DataMergeOptions> data_merge_schema();
 void setup_data_merge(CLI::App& data);
-nlohmann::ordered_json run_data_merge(const DataMergeOptions& options, const std::filesystem::path& out);
+// Merges into the run directory; its manifest is written once its results.json is.
+nlohmann::ordered_json run_data_merge(const DataMergeOptions& options, RunDir& run_dir);
 
 }  // namespace cgsr::cli

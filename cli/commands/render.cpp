@@ -22,7 +22,7 @@ void setup_render(CLI::App& app) {
             "a scene config to render into the data set (repeatable: a scene set; config key 'scenes')");
       },
       [](const RenderOptions& options, const YAML::Node&, RunDir* run_dir) {
-        return run_render(options, run_dir->path());
+        return run_render(options, *run_dir);
       },
       /*always_run_dir=*/true, /*place_run_dir=*/{}, check_render);
 }

@@ -174,7 +174,9 @@ TEST(ExtendingSceneSource, TheBoxIsBuiltFromItsConfigBlockAndRendersADataSet) {
   job.shadow_map_size = 64;
   job.scene = block("scene");
   const auto dir = fresh_dir("box");
-  EXPECT_EQ(run_render_job(job, 3, dir).rendered, 3);
+  const RenderJobResult rendered = run_render_job(job, 3, dir);
+  EXPECT_EQ(rendered.rendered, 3);
+  finish_render(dir, rendered.manifest);  // nothing else to write into the data set
   const Dataset data = Dataset::open(dir);
   EXPECT_EQ(data.frames(Split::All).size(), 3u);
   fs::remove_all(dir);

@@ -323,7 +323,14 @@ TEST(MultiSceneData, MergeMixesDataSetsWithoutCopying) {
   const fs::path solo2 = r.root / "solo2";
   ASSERT_EQ(run_cgsr("render --config " + tiny_config() + " --set name=solo --set frames=3 --out " + solo2.string()).exit_code, 0);
   const fs::path out = r.root / "merged";
-  const CliResult merge = run_cgsr("data merge " + r.set.string() + " " + solo2.string() + " --out " + out.string());
+  const std::string args = "data merge " + r.set.string() + " " + solo2.string() + " --out " + out.string();
+  // The manifest is written after results.json: a merge that fails at its results leaves no data set.
+  ::setenv("CGSR_FAULT_NO_SPACE", "results.json", 1);
+  const CliResult full = run_cgsr(args);
+  ::unsetenv("CGSR_FAULT_NO_SPACE");
+  EXPECT_EQ(full.exit_code, 2) << full.all();
+  EXPECT_FALSE(has_manifest(out));
+  const CliResult merge = run_cgsr(args);
   ASSERT_EQ(merge.exit_code, 0) << merge.all();
   const DatasetManifest m = read_manifest(out);
   ASSERT_EQ(m.scenes.size(), 3u);  // the set contributes its two scenes

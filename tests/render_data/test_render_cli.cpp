@@ -72,6 +72,27 @@ TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
   EXPECT_NE(damaged.all().find("unreadable             1"), std::string::npos) << damaged.all();
 }
 
+// The manifest says complete only once everything after the frames is written: a render whose
+// results.json cannot be written (a full disk, injected) exits 2 with the manifest incomplete,
+// and the rerun finishes it from the frames on disk.
+TEST(RenderCli, TheManifestIsMarkedCompleteOnlyAfterTheResults) {
+  const fs::path out = test::temp_dir("cli_render_results") / "tiny";
+  const std::string args = "render --config " + tiny_config() + " --set frames=2 --out " + out.string();
+  ::setenv("CGSR_FAULT_NO_SPACE", "results.json", 1);
+  const CliResult full = run_cgsr(args);
+  ::unsetenv("CGSR_FAULT_NO_SPACE");
+  EXPECT_EQ(full.exit_code, 2) << full.all();
+  EXPECT_NE(full.all().find("results.json"), std::string::npos) << full.all();
+  EXPECT_FALSE(fs::exists(out / "results.json"));
+  EXPECT_FALSE(read_manifest(out).complete);
+
+  const CliResult rerun = run_cgsr(args);
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.all();
+  EXPECT_NE(rerun.all().find("rendered 0 frame(s) (2 resumed)"), std::string::npos) << rerun.all();
+  EXPECT_TRUE(fs::exists(out / "results.json"));
+  EXPECT_TRUE(read_manifest(out).complete);
+}
+
 TEST(RenderCli, PreviewWritesAMontage) {
   const fs::path out = test::temp_dir("cli_preview") / "tiny";
   ASSERT_EQ(run_cgsr("render --config " + tiny_config() + " --set frames=2 --out " + out.string()).exit_code, 0);
