@@ -214,16 +214,9 @@ std::string number(double x) {
   return out.str();
 }
 
-namespace {
-std::string range_text(double lo, double hi) {
-  return "[" + number(lo) + ", " + number(hi) + (std::isinf(hi) ? ")" : "]");
-}
-}  // namespace
-
 void require_in_range(double v, double lo, double hi, const YAML::Node& node, const Cursor& at) {
   if (v >= lo && v <= hi) return;
-  const std::string written = node.IsScalar() ? describe(node) : number(v);
-  at.fail(node, written + " is out of range " + range_text(lo, hi));
+  at.fail(node, node.IsScalar() ? out_of_range(node.Scalar(), lo, hi) : out_of_range(v, lo, hi));
 }
 
 void check_range(const YAML::Node& node, double lo, double hi, const Cursor& at) {
@@ -274,6 +267,13 @@ YAML::Node lift_moved_blocks(const YAML::Node& map, const std::vector<std::strin
   return out;
 }
 }  // namespace detail
+
+std::string out_of_range(const std::string& written, double lo, double hi) {
+  return "'" + written + "' is out of range [" + detail::number(lo) + ", " + detail::number(hi) +
+         (std::isinf(hi) ? ")" : "]");
+}
+
+std::string out_of_range(double value, double lo, double hi) { return out_of_range(detail::number(value), lo, hi); }
 
 std::string block_type(const Block& block) {
   const Cursor at = block.cursor();

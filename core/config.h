@@ -79,6 +79,14 @@ struct Block {
   Cursor cursor() const { return {doc.get(), path}; }
 };
 
+// The wording of every range error: "'<value>' is out of range [lo, hi]" ("[lo, inf)" when hi is
+// infinite). `written` is the value as the user wrote it; a number is written as short as it reads.
+// Range checks of config nodes are Schema::range (detail::require_in_range); other inputs (a model
+// spec, a manifest, a scene) use these messages so every range error reads the same.
+std::string out_of_range(const std::string& written, double lo, double hi);
+std::string out_of_range(double value, double lo, double hi);
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();  // a range's missing upper end
+
 // ---- value codecs: how a scalar or list field is read from and written to YAML ----------------
 
 template <class V, class Enable = void>
@@ -124,8 +132,7 @@ struct Codec<V, std::enable_if_t<std::is_integral_v<V> && !std::is_same_v<V, boo
         const double lo = static_cast<double>(std::numeric_limits<V>::lowest());
         const double hi = static_cast<double>(std::numeric_limits<V>::max());
         if (x >= lo && x < hi) return static_cast<V>(x);
-        at.fail(n, detail::describe(n) + " is out of range [" + std::to_string(std::numeric_limits<V>::lowest()) +
-                       ", " + std::to_string(std::numeric_limits<V>::max()) + "]");
+        at.fail(n, out_of_range(n.Scalar(), lo, hi));
       }
     }
     return detail::scalar_as<V>(n, at, "an integer");
@@ -217,7 +224,7 @@ class Schema {
       f.bounds = {lo, hi};
       return *this;
     }
-    FieldBuilder& at_least(double lo) { return range(lo, std::numeric_limits<double>::infinity()); }
+    FieldBuilder& at_least(double lo) { return range(lo, kUnbounded); }
     FieldBuilder& one_of(std::vector<std::string> allowed) {
       auto& f = schema_.fields_[index_];
       auto previous = f.validate;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/color.h"
+#include "core/config.h"
 #include "core/error.h"
 #include "core/tensor_checks.h"
 
@@ -36,7 +37,7 @@ std::pair<torch::Tensor, torch::Tensor> prepare(const torch::Tensor& output, con
     b = rgb_to_y(b);
   }
   const int64_t crop = options.crop_border;
-  if (crop < 0) throw Error(metric, "crop_border must be >= 0");
+  if (crop < 0) throw Error(metric, "crop_border " + config::out_of_range(static_cast<double>(crop), 0, config::kUnbounded));
   if (crop > 0) {
     if (a.size(2) <= 2 * crop || a.size(3) <= 2 * crop)
       throw Error(metric, "crop_border " + std::to_string(crop) + " leaves nothing of a " +

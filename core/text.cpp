@@ -6,6 +6,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/config.h"
 #include "core/error.h"
 
 namespace cgsr {
@@ -69,14 +70,17 @@ std::vector<std::string> split(const std::string& text, char separator) {
 
 std::pair<int, int> parse_size(const std::string& text, const std::string& what) {
   const auto parts = split(text, 'x');
+  constexpr size_t kMaxDigits = 6;
   auto is_number = [](const std::string& s) {
-    return !s.empty() && s.size() < 7 && std::all_of(s.begin(), s.end(), ::isdigit);
+    return !s.empty() && s.size() <= kMaxDigits && std::all_of(s.begin(), s.end(), ::isdigit);
   };
   if (parts.size() != 2 || !is_number(parts[0]) || !is_number(parts[1]))
     throw Error(what, "expected a size WxH such as 320x240, got '" + text + "'");
   const int w = std::stoi(parts[0]);
   const int h = std::stoi(parts[1]);
-  if (w <= 0 || h <= 0) throw Error(what, "width and height must be positive, got '" + text + "'");
+  constexpr double kLargest = 999999;  // kMaxDigits digits
+  if (w <= 0) throw Error(what, "size " + text + ": width " + config::out_of_range(parts[0], 1, kLargest));
+  if (h <= 0) throw Error(what, "size " + text + ": height " + config::out_of_range(parts[1], 1, kLargest));
   return {w, h};
 }
 

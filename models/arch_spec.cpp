@@ -120,7 +120,7 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   }
   const BackboneInfo& info = registry.get(spec.backbone);
   if (spec.scale < 2 || spec.scale > 4) {
-    problems.push_back({"scale", "scale must be 2, 3 or 4, got " + std::to_string(spec.scale)});
+    problems.push_back({"scale", config::out_of_range(spec.scale, 2, 4)});
     return problems;
   }
   if (spec.colors == Colors::Y && !info.supports_y)
@@ -130,9 +130,7 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   if (spec.blocks >= 0 && (spec.blocks < info.min_blocks || spec.blocks > info.max_blocks))
     problems.push_back({"blocks", info.max_blocks == 0
                                       ? spec.backbone + " has no residual blocks; blocks must be 0"
-                                      : "blocks must be in [" + std::to_string(info.min_blocks) + ", " +
-                                            std::to_string(info.max_blocks) + "], got " +
-                                            std::to_string(spec.blocks)});
+                                      : config::out_of_range(spec.blocks, info.min_blocks, info.max_blocks)});
   const int blocks = std::clamp(effective_blocks(spec, info), info.min_blocks, info.max_blocks);
   std::vector<std::string> names;
   for (const auto& g : info.groups(spec.scale, blocks)) names.push_back(g.name);
@@ -150,8 +148,7 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
                                    did_you_mean(group, names) + "; groups: " + valid,
                           /*at_key=*/true});
     } else if (width < 1) {
-      problems.push_back({key, "width of layer group '" + group + "' must be at least 1, got " +
-                                   std::to_string(width)});
+      problems.push_back({key, config::out_of_range(width, 1, config::kUnbounded)});
     }
   }
   if (spec.rit.enabled && spec.rit.channels.empty())
@@ -162,13 +159,13 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.channels", e.message()});
   }
   if (spec.rit.width < 1)
-    problems.push_back({"rit.width", "must be at least 1, got " + std::to_string(spec.rit.width)});
+    problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)
-    problems.push_back({"rit.hr_width", "must be at least 1, got " + std::to_string(spec.rit.hr_width)});
+    problems.push_back({"rit.hr_width", config::out_of_range(spec.rit.hr_width, 1, config::kUnbounded)});
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
-    problems.push_back({"geometry.width", "must be at least 1, got " + std::to_string(spec.geometry.width)});
+    problems.push_back({"geometry.width", config::out_of_range(spec.geometry.width, 1, config::kUnbounded)});
   return problems;
 }
 

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/text.h"
 #include "render_data/derive_channels.h"
@@ -162,8 +163,7 @@ class CgsrDataset : public FrameSource {
 const SceneInfo& find_scene(const DatasetInfo& info, int frame) {
   for (const auto& s : info.scenes)
     if (s.contains(frame)) return s;
-  throw Error(info.root.string(), "frame " + std::to_string(frame) + " out of range (" + std::to_string(info.frames) +
-                                      " frames)");
+  throw Error(info.root.string(), "frame " + config::out_of_range(frame, 0, info.frames - 1));
 }
 }  // namespace
 
@@ -218,7 +218,7 @@ struct Dataset::Impl {
 
   Frame load(int index, size_t res) const {
     if (index < 0 || index >= info.frames)
-      throw Error(info.root.string(), "frame " + std::to_string(index) + " out of range (" + std::to_string(info.frames) + " frames)");
+      throw Error(info.root.string(), "frame " + config::out_of_range(index, 0, info.frames - 1));
     if (res >= info.resolutions.size()) throw Error(info.root.string(), "resolution index out of range");
     std::vector<RenderChannel> here;  // what this resolution's files can give
     for (auto c : load_channels)

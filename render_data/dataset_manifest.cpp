@@ -20,9 +20,11 @@ Resolution parse_resolution(const std::string& text, const std::string& context)
   const auto [w, h] = parse_size(text, context);
   // A frame must be an image cgsr reads back (core/image_header.h); a larger one would also
   // exhaust memory while it renders.
-  if (w > kMaxImageSide || h > kMaxImageSide || int64_t{w} * h > kMaxImagePixels)
-    throw Error(context, "resolution " + text + " is out of range: at most " + std::to_string(kMaxImageSide) +
-                             " pixels a side and " + std::to_string(kMaxImagePixels) + " pixels in all");
+  const std::string at = "resolution " + text + ": ";
+  if (w > kMaxImageSide) throw Error(context, at + "width " + config::out_of_range(w, 1, kMaxImageSide));
+  if (h > kMaxImageSide) throw Error(context, at + "height " + config::out_of_range(h, 1, kMaxImageSide));
+  if (int64_t{w} * h > kMaxImagePixels)
+    throw Error(context, at + "pixel count " + config::out_of_range(static_cast<double>(int64_t{w} * h), 1, kMaxImagePixels));
   return {w, h};
 }
 
@@ -209,10 +211,10 @@ void read_scenes(const YAML::Node& list, const config::Cursor& at, DatasetManife
     if (e["weight"]) sc.weight = config::Codec<double>::decode(e["weight"], eat.child("weight"));
     if (sc.name.empty()) eat.child("name").fail(e["name"], "must not be empty");
     if (sc.path.empty()) eat.child("path").fail(e["path"], "must not be empty");
-    if (sc.frames < 1) eat.child("frames").fail(e["frames"], "must be at least 1");
+    config::detail::require_in_range(sc.frames, 1, config::kUnbounded, e["frames"], eat.child("frames"));
     if (sc.first_frame != next)
       eat.child("first_frame").fail(e["first_frame"], "must be " + std::to_string(next) + " (the frames of the scenes before)");
-    if (sc.weight < 0) eat.child("weight").fail(e["weight"], "must be at least 0");
+    if (e["weight"]) config::detail::require_in_range(sc.weight, 0, config::kUnbounded, e["weight"], eat.child("weight"));
     for (const auto& other : m.scenes)
       if (other.name == sc.name) eat.child("name").fail(e["name"], "scene '" + sc.name + "' is listed twice");
     next += sc.frames;
@@ -248,7 +250,7 @@ DatasetManifest read_manifest(const fs::path& root) {
   m.complete = config::Codec<bool>::decode(need("complete"), at.child("complete"));
   m.fingerprint = config::Codec<std::string>::decode(need("fingerprint"), at.child("fingerprint"));
   m.frames = config::Codec<int>::decode(need("frames"), at.child("frames"));
-  if (m.frames < 1) at.child("frames").fail(n["frames"], "must be at least 1");
+  config::detail::require_in_range(m.frames, 1, config::kUnbounded, n["frames"], at.child("frames"));
   for (const auto& r : config::Codec<std::vector<std::string>>::decode(need("resolutions"), at.child("resolutions")))
     m.resolutions.push_back(parse_resolution(r, doc.locate(n["resolutions"]) + ": resolutions"));
   if (m.resolutions.empty()) at.child("resolutions").fail(n["resolutions"], "needs at least one resolution");
@@ -273,7 +275,7 @@ DatasetManifest read_manifest(const fs::path& root) {
     auto& list = const_cast<std::vector<int>&>(m.split.of(s));
     list = config::Codec<std::vector<int>>::decode(split[key], sat.child(key));
     for (int f : list)
-      if (f < 0 || f >= m.frames) sat.child(key).fail(split[key], "frame " + std::to_string(f) + " out of range");
+      if (f < 0 || f >= m.frames) sat.child(key).fail(split[key], "frame " + config::out_of_range(f, 0, m.frames - 1));
   }
   if (const YAML::Node bytes = n["bytes_per_frame"]) {
     const config::Cursor bat = at.child("bytes_per_frame");
@@ -306,7 +308,8 @@ DatasetManifest scene_set_manifest(const std::string& name, const std::vector<Re
       auto& into = const_cast<std::vector<int>&>(m.split.of(s));
       for (int f : splits[i].of(s)) into.push_back(sc.first_frame + f);
     }
-    if (sc.weight < 0) throw Error(sc.path, "scene '" + sc.name + "': weight must be at least 0");
+    if (sc.weight < 0)
+      throw Error(sc.path, "scene '" + sc.name + "': weight " + config::out_of_range(sc.weight, 0, config::kUnbounded));
     if ((sc.weight > 0) != (scenes[0].weight > 0))
       throw Error(sc.path, "scene '" + sc.name + "': give every scene a weight, or none (then scenes are drawn in "
                            "proportion to their training frames)");

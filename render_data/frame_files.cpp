@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include "core/atomic_file.h"
+#include "core/config.h"
 #include "core/error.h"
 #include "core/image_header.h"
 #include "core/image_io.h"
@@ -186,7 +187,7 @@ torch::Tensor read_motion_file(const fs::path& path, int frame, const Resolution
 Frame read_dataset_frame(const fs::path& root, const DatasetManifest& m, int frame, size_t res,
                          const std::vector<RenderChannel>& channels) {
   if (frame < 0 || frame >= m.frames)
-    throw Error(root.string(), "frame " + std::to_string(frame) + " out of range (" + std::to_string(m.frames) + " frames)");
+    throw Error(root.string(), "frame " + config::out_of_range(frame, 0, m.frames - 1));
   const Resolution& r = m.resolutions.at(res);
   auto want = [&](RenderChannel c) { return std::find(channels.begin(), channels.end(), c) != channels.end(); };
   Frame f;

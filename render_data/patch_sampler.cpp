@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <deque>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/runtime.h"
 #include "render_data/augment.h"
@@ -17,7 +18,7 @@ std::pair<size_t, size_t> resolution_pair(const Dataset& data, int scale, int lr
   const auto& rs = data.resolutions();
   std::vector<std::string> names;
   for (const auto& r : rs) names.push_back(r.name());
-  if (scale < 1) throw Error("sampler", "scale must be at least 1");
+  if (scale < 1) throw Error("sampler", "scale " + config::out_of_range(scale, 1, config::kUnbounded));
   for (size_t lo = 0; lo < rs.size(); ++lo) {
     if (lr_width > 0 && rs[lo].width != lr_width) continue;
     for (size_t hi = 0; hi < rs.size(); ++hi)
@@ -119,8 +120,9 @@ struct PatchSampler::Prefetch {
 PatchSampler::PatchSampler(Dataset data, PatchSamplerOptions options)
     : data_(std::move(data)), options_(std::move(options)), prefetch_(std::make_unique<Prefetch>()) {
   const auto& o = options_;
-  if (o.patch_size < 1 || o.batch_size < 1) throw Error("sampler", "patch and batch must be at least 1");
-  if (o.prefetch < 0) throw Error("sampler", "prefetch must be >= 0");
+  if (o.patch_size < 1) throw Error("sampler", "patch_size " + config::out_of_range(o.patch_size, 1, config::kUnbounded));
+  if (o.batch_size < 1) throw Error("sampler", "batch_size " + config::out_of_range(o.batch_size, 1, config::kUnbounded));
+  if (o.prefetch < 0) throw Error("sampler", "prefetch " + config::out_of_range(o.prefetch, 0, config::kUnbounded));
   std::tie(lr_, hr_) = resolution_pair(data_, o.scale, o.lr_width);
   const Resolution& lr = data_.resolutions()[lr_];
   if (o.patch_size > lr.width || o.patch_size > lr.height)

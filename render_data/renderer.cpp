@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/config.h"
 #include "core/error.h"
 
 namespace cgsr {
@@ -51,7 +52,8 @@ Vec3 sky_color(const Sky& sky, Vec3 direction) {
 SceneRenderer::SceneRenderer(const Scene& scene, const RenderSettings& settings)
     : settings_(settings), geometry_(scene) {
   CGSR_CHECK(settings.tile_size >= 4, "tile size must be at least 4");
-  if (settings.shadow.map_size < 16) throw Error("render settings", "shadow map size must be at least 16");
+  if (settings.shadow.map_size < 16)
+    throw Error("render settings", "shadow map size " + config::out_of_range(settings.shadow.map_size, 16, config::kUnbounded));
   const Scene& s = geometry_.scene();
   shadow_maps_.resize(s.lights.size());
   if (settings.shadows)
@@ -203,7 +205,8 @@ Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const Sur
 
 GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous, int width, int height,
                               float near_plane, float far_plane) const {
-  if (width <= 0 || height <= 0) throw Error("render", "image size must be positive");
+  if (width <= 0) throw Error("render", "image width " + config::out_of_range(width, 1, config::kUnbounded));
+  if (height <= 0) throw Error("render", "image height " + config::out_of_range(height, 1, config::kUnbounded));
   RenderContext ctx;
   ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane);
   ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/config.h"
 #include "core/error.h"
 
 namespace cgsr {
@@ -116,7 +117,7 @@ void validate_scene(const Scene& scene) {
       if (idx >= n) throw Error(where, "index " + std::to_string(idx) + " out of range (" + std::to_string(n) + " vertices)");
     if (mesh.material < 0 || mesh.material >= static_cast<int>(scene.materials.size()))
       throw Error(where, "material index " + std::to_string(mesh.material) + " out of range");
-    if (mesh.object_id < 0) throw Error(where, "object_id must be >= 0");
+    if (mesh.object_id < 0) throw Error(where, "object_id " + config::out_of_range(mesh.object_id, 0, config::kUnbounded));
     if (scene.materials[mesh.material].lightmap_texture >= 0 && mesh.lightmap_uvs.empty())
       throw Error(where, "its material has a lightmap but the mesh has no lightmap_uvs");
     for (size_t v = 0; v < n; ++v)
@@ -132,7 +133,8 @@ void validate_scene(const Scene& scene) {
     if (light.type == LightType::Directional && !(length(light.direction) > 0))
       throw Error(where, "a directional light needs a non-zero direction");
   }
-  if (!(scene.fog.density >= 0) || !std::isfinite(scene.fog.density)) throw Error(ctx, "fog density must be >= 0");
+  if (!(scene.fog.density >= 0) || !std::isfinite(scene.fog.density))
+    throw Error(ctx, "fog density " + config::out_of_range(scene.fog.density, 0, config::kUnbounded));
 }
 
 void scene_bounds(const Scene& scene, Vec3& lo, Vec3& hi) {

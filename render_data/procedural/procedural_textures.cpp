@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/text.h"
 #include "render_data/vec_math.h"
@@ -88,7 +89,7 @@ float tileable_noise(float x, float y, int period, int octaves, uint64_t seed) {
 bool texture_kind_has_holes(TextureKind kind) { return kind == TextureKind::ChainLink || kind == TextureKind::Grate; }
 
 Texture make_texture(TextureKind kind, int size, uint64_t seed, Vec3 base, Vec3 accent) {
-  if (size < 16) throw Error("texture", "size must be at least 16 texels");
+  if (size < 16) throw Error("texture", "size " + config::out_of_range(size, 16, config::kUnbounded));
   const int N = size;
   const bool rgba = texture_kind_has_holes(kind);
   Canvas canvas(N, rgba ? 4 : 3);

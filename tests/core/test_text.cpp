@@ -24,4 +24,10 @@ TEST(Text, ParseSize) {
   EXPECT_THROW(parse_size("0x10", "--input"), Error);
   EXPECT_THROW(parse_size("axb", "--input"), Error);
   EXPECT_THROW(parse_size("-3x4", "--input"), Error);
+  try {
+    parse_size("320x0", "--input");
+    FAIL() << "a zero height accepted";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "--input: size 320x0: height '0' is out of range [1, 999999]");
+  }
 }

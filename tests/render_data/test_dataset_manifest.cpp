@@ -94,7 +94,17 @@ TEST(DatasetManifest, MalformedManifestsNameFileAndKey) {
     read_manifest(dir);
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("frame 7 out of range"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("split.train: frame '7' is out of range [0, 3]"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "manifest.yaml", std::ios::trunc)
+      << "format: cgsr-dataset\nversion: 1\nname: x\ncomplete: true\nfingerprint: a\n"
+         "frames: 0\nresolutions: [320x240]\nnear: 0.1\nfar: 10\nsplit: {train: [], val: [], test: []}\n";
+  try {
+    read_manifest(dir);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("manifest.yaml:6:9: frames: '0' is out of range [1, inf)"), std::string::npos)
+        << e.what();
   }
 }
 
