@@ -7,13 +7,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/image_header.h"
 #include "render_data/q3/pk3_archive.h"
 #include "render_data/q3/script_tokens.h"
 
 namespace cgsr::q3 {
 namespace {
 
-constexpr int64_t kMaxPixels = 8192LL * 8192;
 const char* const kExtensions[] = {".tga", ".jpg", ".png", ".jpeg"};
 
 std::string extension_of(const std::string& name) {
@@ -37,16 +37,26 @@ Texture from_rgba(const uint8_t* rgba, int width, int height, const std::string&
   return t;
 }
 
+// The size the image declares, from its header alone (stb_image reads a TGA's, core/image_header.h
+// the others'), so that a small file declaring a huge image is refused before a decoder allocates it.
+ImageHeader declared_size(const std::vector<uint8_t>& bytes, const std::string& name) {
+  if (extension_of(name) == ".tga") {
+    int width = 0, height = 0, channels = 0;
+    if (!stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height, &channels))
+      throw Error(name, std::string("cannot decode TGA: ") + stbi_failure_reason());
+    return {"TGA", width, height};
+  }
+  return parse_image_header(std::string(bytes.begin(), bytes.end()), name);
+}
+
 }  // namespace
 
 Texture decode_image(const std::vector<uint8_t>& bytes, const std::string& name, bool keep_alpha) {
   if (bytes.empty()) throw Error(name, "image file is empty");
   if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) throw Error(name, "image file is too large");
+  check_image_limits(declared_size(bytes, name), name);
   if (extension_of(name) == ".tga") {
     int width = 0, height = 0, channels = 0;
-    if (!stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height, &channels))
-      throw Error(name, std::string("cannot decode TGA: ") + stbi_failure_reason());
-    if (static_cast<int64_t>(width) * height > kMaxPixels) throw Error(name, "image is too large");
     std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
         stbi_load_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height, &channels, 4),
         stbi_image_free);
@@ -62,7 +72,6 @@ Texture decode_image(const std::vector<uint8_t>& bytes, const std::string& name,
   }
   if (image.empty()) throw Error(name, "cannot decode image (not a valid JPG/PNG)");
   if (image.depth() != CV_8U) image.convertTo(image, CV_8U, image.depth() == CV_16U ? 1.0 / 257 : 255.0);
-  if (static_cast<int64_t>(image.cols) * image.rows > kMaxPixels) throw Error(name, "image is too large");
   cv::Mat rgba;
   switch (image.channels()) {
     case 1: cv::cvtColor(image, rgba, cv::COLOR_GRAY2RGBA); break;

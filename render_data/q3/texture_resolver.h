@@ -17,7 +17,8 @@ namespace cgsr::q3 {
 class Pk3FileSystem;
 
 // Decodes TGA/JPG/PNG bytes to an 8-bit RGB (keep_alpha false) or RGBA texture, rows top to
-// bottom (TGA's bottom-up origin is undone). cgsr::Error naming `name` when it cannot.
+// bottom (TGA's bottom-up origin is undone). cgsr::Error naming `name` when it cannot, or when
+// its header declares more than core/image_header.h's limits (checked before decoding).
 Texture decode_image(const std::vector<uint8_t>& bytes, const std::string& name, bool keep_alpha);
 
 class TextureResolver {

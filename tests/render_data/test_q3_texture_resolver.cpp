@@ -2,6 +2,8 @@
 // (stb_image, either row order) and JPG (OpenCV).
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "core/error.h"
 #include "render_data/q3/pk3_archive.h"
 #include "render_data/q3/texture_resolver.h"
@@ -59,6 +61,28 @@ TEST(Q3TextureResolver, UndecodableImagesAreErrorsNamingTheFile) {
     }
   }
   EXPECT_THROW(decode_image({}, "empty.tga", false), Error);
+}
+
+// A texture declaring a huge size is refused from its header, naming the file, before a decoder
+// allocates it: a TGA header alone declaring 65535x65535 (16 GiB of RGBA), and a PNG's IHDR
+// declaring 20000x20000 with no pixel data after it.
+TEST(Q3TextureResolver, HugeDeclaredSizesAreRefusedBeforeDecoding) {
+  std::vector<uint8_t> tga = testing::encode_tga(1, 1, 3, {1, 2, 3}, false);
+  tga[12] = tga[13] = tga[14] = tga[15] = 0xFF;  // width and height 65535
+  const std::string ihdr("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x4e\x20\0\0\x4e\x20\x08\x02\0\0\0\0\0\0\0", 33);
+  const std::vector<uint8_t> png(ihdr.begin(), ihdr.end());
+  for (const auto& [name, bytes, declared] :
+       {std::tuple{"textures/x/bomb.tga", tga, "the TGA header declares 65535x65535 pixels"},
+        std::tuple{"textures/x/bomb.png", png, "the PNG header declares 20000x20000 pixels"}}) {
+    try {
+      decode_image(bytes, name, false);
+      FAIL() << "expected an error for " << name;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.context(), name);
+      EXPECT_NE(std::string(e.what()).find(declared), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not decoded"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
