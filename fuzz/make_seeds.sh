@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Regenerates the seed inputs in fuzz/corpus/ from what cgsr itself writes: the manifest and
-# the 64x48 files of frame 0 of configs/scenes/tiny.yaml, and a small CG-enhanced PAN model
-# file (format version 2) next to the version 1 test fixture (tests/data/model_file_v1.cgsr, which
-# this cgsr can no longer write). Config seeds are the files in configs/ (the fuzz tests read them
-# there) plus the hand-written ones in fuzz/corpus/config/ (regressions and the configs' former
-# shapes), which this script leaves alone.
+# the 64x48 files of frame 0 of configs/scenes/tiny.yaml with decompression bombs beside them
+# (fuzz/make_bomb_seeds.py), and a small CG-enhanced PAN model file (format version 2) next to
+# the version 1 test fixture (tests/data/model_file_v1.cgsr, which this cgsr can no longer write).
+# Config seeds are the files in configs/ (the fuzz tests read them there) plus the hand-written
+# ones in fuzz/corpus/config/ (regressions and the configs' former shapes), which this script
+# leaves alone.
 #   fuzz/make_seeds.sh [BUILD_DIR]     (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,17 +26,8 @@ for kind in color depth normal normal_angle edge id motion; do
   kind_byte=$((kind_byte + 1))
 done
 
-# A decompression bomb as a colour file: a PNG of a few hundred bytes whose header declares
-# 20000x20000 pixels (its data holds 16 rows of them); it must be refused before decoding.
-python3 - <<'PY'
-import struct, zlib
-def chunk(kind, data):
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
-rows = zlib.compress((b"\0" + bytes(3 * 20000)) * 16, 9)
-png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 20000, 20000, 8, 2, 0, 0, 0)) +
-       chunk(b"IDAT", rows) + chunk(b"IEND", b""))
-open("fuzz/corpus/frame_files/color_bomb_20000x20000.bin", "wb").write(b"\0" + png)
-PY
+# Decompression bombs (PNG, JPEG, EXR), each a few KB declaring 20000x20000 pixels.
+python3 fuzz/make_bomb_seeds.py
 
 printf 'backbone: pan\nscale: 2\nblocks: 1\nwidths: {features: 8}\n' > "$work/spec.yaml"
 "$cgsr" train --data "$work/data" --model "$work/spec.yaml" --out "$work/train" --threads 1 \

@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <filesystem>
+#include <tuple>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/atomic_file.h"
@@ -95,4 +96,19 @@ TEST(ImageHeader, ADecompressionBombIsRefusedBeforeDecoding) {
             std::string::npos)
       << e;
   EXPECT_EQ(read_image(large, {3, 640, 480}).size(2), 640);
+}
+
+// fuzz_frame_files' bombs in each format a frame file can reach (fuzz/make_bomb_seeds.py): a JPEG
+// of 157 bytes and an EXR of 11 KB declare 20000x20000 as the PNG does, each refused from its header.
+TEST(ImageHeader, EveryBombSeedIsRefusedFromItsHeader) {
+  for (const auto& [seed, format, extension] :
+       {std::tuple{"color_bomb_20000x20000.bin", "PNG", ".png"}, std::tuple{"color_jpeg_bomb_20000x20000.bin", "JPEG", ".png"},
+        std::tuple{"depth_bomb_20000x20000.bin", "EXR", ".exr"}}) {
+    const std::string bytes = read_file(fs::path(CGSR_SOURCE_DIR) / "fuzz/corpus/frame_files" / seed).substr(1);
+    const fs::path bomb = header_dir() / (std::string(seed) + extension);
+    write_file_atomic(bomb, bytes);
+    EXPECT_LT(fs::file_size(bomb), 16384u) << seed;
+    const std::string e = header_error_of([&] { read_image(bomb); });
+    EXPECT_NE(e.find(std::string("the ") + format + " header declares 20000x20000 pixels"), std::string::npos) << e;
+  }
 }
