@@ -291,6 +291,30 @@ class Pipeline {
     return results_;
   }
 
+  // What --check does beyond plan(): builds the networks the training stages would train
+  // (check_train), so a spec or an enhancement the run would refuse at its train stage, after
+  // the render, fails --check. A later stage starts from an earlier one's model file, which does
+  // not exist yet: its network is built from the train stage's model instead.
+  std::string check_networks() const {
+    TrainOptions enhance = enhanced_;
+    enhance.model = backbone_.model;
+    enhance.scale = backbone_.scale;
+    TrainOptions elastic = elastic_;
+    elastic.model = backbone_.model;
+    elastic.scale = backbone_.scale;
+    elastic.enhance = enhanced_.enhance;
+    std::string out;
+    for (const auto& [stage, options] : {std::pair<const char*, const TrainOptions*>{"train", &backbone_},
+                                         {"enhance", &enhance}, {"elastic", &elastic}}) {
+      try {
+        out += "  " + check_train(*options);
+      } catch (const Error& e) {
+        throw e.within(stage);
+      }
+    }
+    return out;
+  }
+
   // What --check prints: the constructor parsed every stage's section; this parses every scene
   // config the run names too (the held-out ones are read only when that stage starts, hours in)
   // and says what each stage will do.
@@ -839,7 +863,8 @@ nlohmann::ordered_json run_pipeline(const PipelineOptions& options, const YAML::
 }
 
 std::string check_pipeline(const PipelineOptions& options, const fs::path& dir) {
-  return dir.string() + ":\n" + Pipeline(options, YAML::Node(), dir).plan();
+  const Pipeline pipeline(options, YAML::Node(), dir);
+  return dir.string() + ":\n" + pipeline.plan() + pipeline.check_networks();
 }
 
 }  // namespace cgsr

@@ -93,18 +93,54 @@ void write_loss_curve(const std::filesystem::path& path, const TrainOutcome& out
 }
 }  // namespace
 
-nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
-  ModelSource source = resolve_model(options.model, options.scale);
-  SRNetwork network = source.network;
-  std::string stage = "backbone";
+namespace {
+// The network a training trains, built before any data is read.
+struct NetworkToTrain {
+  ModelSource source;                 // the model it starts from
+  SRNetwork network{nullptr};
+  std::string stage;                  // "backbone", "cg-enhanced" or "elastic"
+  std::optional<ElasticSpace> space;  // an elastic training's
+};
+
+// The model (a backbone name, a spec or a model file), with the RIT inserted when enhancing and
+// made elastic when asked: what the run builds first and what --check builds, so both apply a
+// spec's ranges, the RIT's channels and the elastic space's options.
+NetworkToTrain network_to_train(const TrainOptions& options) {
+  NetworkToTrain t;
+  t.source = resolve_model(options.model, options.scale);
+  t.network = t.source.network;
+  t.stage = "backbone";
   if (options.enhance.enabled) {
-    ArchSpec child = source.spec;
+    ArchSpec child = t.source.spec;
     child.rit = options.enhance.rit;
     child.rit.enabled = true;
     child.geometry = options.enhance.geometry;
-    network = inherit(*source.network, resolve_spec(child)).network;
-    stage = "cg-enhanced";
+    t.network = inherit(*t.source.network, resolve_spec(child)).network;
+    t.stage = "cg-enhanced";
   }
+  if (options.elastic.enabled) {
+    if (options.distill.enabled())
+      throw Error("train: distill", "an elastic network distils from its own full network; remove 'distill'");
+    ElasticNetwork elastic = make_elastic(*t.network, options.elastic.space);
+    t.network = elastic.network;
+    t.space.emplace(elastic.space);
+    t.stage = "elastic";
+  }
+  return t;
+}
+}  // namespace
+
+std::string check_train(const TrainOptions& options) {
+  const NetworkToTrain t = network_to_train(options);
+  return "network  " + spec_summary(t.network->spec()) + ", " + t.stage + ", " +
+         std::to_string(inference_parameter_count(*t.network)) + " parameters\n";
+}
+
+nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir) {
+  const NetworkToTrain start = network_to_train(options);
+  const ModelSource& source = start.source;
+  const std::string& stage = start.stage;
+  SRNetwork network = start.network;
   // Only what the network reads (its geometry targets are the same channels at HR).
   const Dataset data = open_for_channels(options.data, network->input_channels());
   const std::string name = options.name.empty() ? spec_summary(network->spec()) : options.name;
@@ -113,16 +149,10 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
 
   TrainHooks hooks;
   nlohmann::ordered_json extra = {{"name", name}, {"data", data.info().root.string()}};
-  std::optional<ElasticSpace> space;
-  if (options.elastic.enabled) {
-    if (options.distill.enabled())
-      throw Error("train: distill", "an elastic network distils from its own full network; remove 'distill'");
-    ElasticNetwork elastic = make_elastic(*network, options.elastic.space);
-    network = elastic.network;
-    space.emplace(elastic.space);
+  const std::optional<ElasticSpace>& space = start.space;
+  if (space) {
     hooks = elastic_training_hooks(network, *space, options.elastic, options.loss, options.schedule.steps,
                                    static_cast<uint64_t>(options.seed));
-    stage = "elastic";
     spdlog::info("{}: elastic over {} layer groups and {} blocks (at least {})", name, space->genes().size(),
                  space->total_blocks(), space->min_blocks());
   } else if (options.distill.enabled()) {

@@ -49,5 +49,9 @@ config::Schema<TrainOptions> enhance_stage_schema();
 // distill, depth, width, latency) sit at its top level, as the stage always trains elastically.
 config::Schema<TrainOptions> elastic_stage_schema();
 nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& resolved, RunDir& run_dir);
+// What `cgsr train --check` does beyond the schema: builds the network the run would train (the
+// model, the RIT when enhancing, the elastic space when elastic; no data is read), so a spec file
+// or an enhancement the run would refuse fails --check too. Returns a line saying what it built.
+std::string check_train(const TrainOptions& options);
 
 }  // namespace cgsr

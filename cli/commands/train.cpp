@@ -24,7 +24,8 @@ void setup_train(CLI::App& app) {
       /*always_run_dir=*/true,
       [](const TrainOptions& options, const std::filesystem::path& out) {
         return rank_run_dir(options.distributed, out);
-      });
+      },
+      check_train);
 }
 
 }  // namespace cgsr::cli

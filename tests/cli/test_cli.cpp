@@ -142,6 +142,25 @@ TEST(Cli, ARunDirectoryOfAnotherCommandIsRefusedUnlessForced) {
   EXPECT_NE(r.err.find("belongs to 'cgsr data check' (.cgsr.lock)"), std::string::npos) << r.err;
 }
 
+// train --check builds the network the run would train: a spec file out of range, or a RIT
+// reading an unknown channel, used to pass --check and fail the run. (run --check:
+// RunCommand.CheckReadsEverySceneConfigAndWritesNothing.)
+TEST(Cli, TrainCheckBuildsTheNetworkTheRunWould) {
+  const auto dir = scratch_dir("cli-train-check");
+  const fs::path spec = dir / "blocks0.yaml";
+  cgsr::write_file_atomic(spec, "backbone: pan\nscale: 2\nblocks: 0\n");
+  const std::string train = "train --data " + (dir / "no-data").string();
+  auto r = run_cgsr(train + " --model " + spec.string() + " --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(spec.string() + ":3:9: blocks: '0' is out of range [1, 64]"), std::string::npos) << r.err;
+  r = run_cgsr(train + " --set enhance.enabled=true --set 'enhance.rit.channels=[bogus]' --check");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown channel 'bogus'"), std::string::npos) << r.err;
+  r = run_cgsr(train + " --set elastic.enabled=true --check");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("network  pan x2, elastic"), std::string::npos) << r.out;
+}
+
 // A non-UTF-8 --out used to pass every check and fail at the very end (exit 1, json type_error
 // 316, no results.json); now it is refused before the directory is made.
 TEST(Cli, ANonUtf8OutPathIsRefusedBeforeAnyWork) {

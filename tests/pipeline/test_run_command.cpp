@@ -274,6 +274,20 @@ TEST(RunCommand, CheckReadsEverySceneConfigAndWritesNothing) {
   const CliResult scene_set = run_cgsr(base + " --set heldout.scenes=[" + (dir / "set.yaml").string() + "]");
   EXPECT_EQ(scene_set.exit_code, 2);
   EXPECT_NE(scene_set.err.find("is a scene set"), std::string::npos) << scene_set.err;
+
+  // The training stages' networks are built: a spec out of range, or a RIT reading an unknown
+  // channel, would otherwise stop the run at its train or enhance stage, after the render.
+  EXPECT_NE(ok.out.find("network  pan x2, backbone"), std::string::npos) << ok.out;
+  std::ofstream(dir / "blocks0.yaml") << "backbone: pan\nscale: 2\nblocks: 0\n";
+  const CliResult spec = run_cgsr(base + " --set train.model=" + (dir / "blocks0.yaml").string());
+  EXPECT_EQ(spec.exit_code, 2);
+  EXPECT_NE(spec.err.find("error: train: " + (dir / "blocks0.yaml").string() + ":3:9: blocks: '0' is out of range [1, 64]"),
+            std::string::npos)
+      << spec.err;
+  const CliResult channels = run_cgsr(base + " --set 'enhance.rit.channels=[bogus]'");
+  EXPECT_EQ(channels.exit_code, 2);
+  EXPECT_NE(channels.err.find("error: enhance: "), std::string::npos) << channels.err;
+  EXPECT_NE(channels.err.find("unknown channel 'bogus'"), std::string::npos) << channels.err;
   EXPECT_FALSE(fs::exists(dir / "run"));
   fs::remove_all(dir);
 }
