@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "core/error.h"
@@ -115,7 +116,10 @@ ImageHeader tiff(const Bytes& b) {
     const uint32_t tag = read(e, 2), type = read(e + 2, 2);
     if (tag != 256 && tag != 257) continue;
     const int64_t value = type == 3 ? read(e + 8, 2) : read(e + 8, 4);  // SHORT or LONG
-    (tag == 256 ? h.width : h.height) = value;
+    int64_t& side = tag == 256 ? h.width : h.height;
+    // A decoder may take either of two: the size checked must be the one decoded.
+    if (side >= 0) b.fail("a TIFF file with its width or height tag twice");
+    side = value;
   }
   if (h.width < 0 || h.height < 0) b.fail("a TIFF file without its width and height tags");
   return h;
@@ -123,27 +127,32 @@ ImageHeader tiff(const Bytes& b) {
 
 ImageHeader exr(const Bytes& b) {
   // Magic and version, then attributes "name\0type\0<int32 size><value>" up to an empty name.
+  // The whole header is read: OpenEXR takes the last of two dataWindows, so two are refused.
   size_t at = 8;
+  std::optional<ImageHeader> found;
   while (true) {
     const size_t name_end = b.data().find('\0', at);
     if (name_end == std::string::npos) b.fail(kCutShort);
     const std::string name = b.data().substr(at, name_end - at);
-    if (name.empty()) b.fail("an OpenEXR header without a dataWindow");
+    if (name.empty()) break;
     const size_t type_end = b.data().find('\0', name_end + 1);
     if (type_end == std::string::npos) b.fail(kCutShort);
     const std::string type = b.data().substr(name_end + 1, type_end - name_end - 1);
     const uint32_t size = b.le(type_end + 1, 4);
     const size_t value = type_end + 5;
     if (name == "dataWindow") {
+      if (found) b.fail("an OpenEXR header with two dataWindows");
       if (type != "box2i" || size != 16) b.fail("an OpenEXR dataWindow that is not a box2i");
       const auto i32 = [&](size_t k) { return static_cast<int64_t>(static_cast<int32_t>(b.le(value + 4 * k, 4))); };
       const int64_t width = i32(2) - i32(0) + 1, height = i32(3) - i32(1) + 1;
       if (width < 1 || height < 1) b.fail("an OpenEXR dataWindow of no pixels");
-      return {"EXR", width, height};
+      found = ImageHeader{"EXR", width, height};
     }
     b.need(value, size);
     at = value + size;
   }
+  if (!found) b.fail("an OpenEXR header without a dataWindow");
+  return *found;
 }
 
 }  // namespace

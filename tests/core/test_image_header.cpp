@@ -112,3 +112,33 @@ TEST(ImageHeader, EveryBombSeedIsRefusedFromItsHeader) {
     EXPECT_NE(e.find(std::string("the ") + format + " header declares 20000x20000 pixels"), std::string::npos) << e;
   }
 }
+
+// A size given twice in a header is refused: decoders take one or the other (OpenEXR the last
+// dataWindow, libtiff the first width tag), so a small size beside a huge one would pass the
+// check and be decoded huge.
+TEST(ImageHeader, ASizeGivenTwiceIsRefused) {
+  const auto image = torch::rand({3, 9, 13});
+  write_image(header_dir() / "twice.exr", image, {32});
+  std::string exr = read_file(header_dir() / "twice.exr");
+  const std::string attribute = std::string("dataWindow\0box2i\0", 17);
+  const size_t at = exr.find(attribute);
+  ASSERT_NE(at, std::string::npos);
+  std::string huge = exr.substr(at, attribute.size() + 4 + 8) + std::string("\x1f\x4e\0\0\x1f\x4e\0\0", 8);  // 19999
+  exr.insert(at + attribute.size() + 4 + 16, huge);
+  EXPECT_NE(header_error_of([&] { parse_image_header(exr, "twice.exr"); }).find("twice.exr: unreadable image: an OpenEXR "
+                                                                               "header with two dataWindows"),
+            std::string::npos);
+
+  write_image(header_dir() / "twice.tif", image, {8});
+  std::string tiff = read_file(header_dir() / "twice.tif");
+  ASSERT_EQ(tiff.substr(0, 2), "II");
+  const auto u16 = [&](size_t k) { return static_cast<uint32_t>(uint8_t(tiff[k]) | uint8_t(tiff[k + 1]) << 8); };
+  const size_t ifd = u16(4) | u16(6) << 16;
+  for (uint32_t i = 0; i < u16(ifd); ++i) {
+    const size_t e = ifd + 2 + 12 * i;
+    if (u16(e) == 257) tiff[e] = 0;  // the height tag becomes a second width tag (256 = 0x100)
+  }
+  EXPECT_NE(header_error_of([&] { parse_image_header(tiff, "twice.tif"); }).find("a TIFF file with its width or height "
+                                                                                "tag twice"),
+            std::string::npos);
+}
