@@ -99,7 +99,8 @@ std::vector<std::string> subnet_problems(const ArchSpec& spec, const SubnetConfi
   if (spec.blocks > 0 && sub.blocks.empty()) p.push_back("keeps no block");
   const auto groups = layer_groups(spec);
   for (const auto& [group, width] : sub.widths) {
-    const auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == group; });
+    // Named in the capture: C++17 lambdas cannot capture a structured binding (clang refuses).
+    const auto it = std::find_if(groups.begin(), groups.end(), [&name = group](const auto& g) { return g.first == name; });
     if (it == groups.end()) {
       p.push_back("no layer group '" + group + "' in " + spec_summary(spec));
       continue;
