@@ -326,7 +326,13 @@ class Compiler {
                                                    : kF32;
     source_of_.assign(g_.values.size(), -1);
     shadow_.assign(g_.values.size(), -1);
-    conv_low_ = low_precision_convs(g_);
+    conv_low_ = options_.low_convs.empty() ? low_precision_convs(g_) : options_.low_convs;
+    if (conv_low_.size() != g_.ops.size())
+      throw Error("fused graph", "low_convs has " + std::to_string(conv_low_.size()) + " entries for " +
+                                     std::to_string(g_.ops.size()) + " ops");
+    for (size_t i = 0; i < conv_low_.size(); ++i)
+      if (conv_low_[i] && g_.ops[i].kind != OpKind::Conv)
+        throw Error("fused graph", "low_convs marks " + g_.ops[i].name + ", which is not a convolution");
     if (low_ == kF32) conv_low_.assign(g_.ops.size(), false);
   }
 

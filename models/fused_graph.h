@@ -65,6 +65,9 @@ class FusedGraph {
     size_t cached_plans = 4;   // plans kept for different input sizes
     Precision precision = Precision::Fp32;
     Calibration calibration;   // Int8: the ranges of the graph's values (calibrate())
+    std::vector<bool> low_convs;  // which ops compute in `precision`, indexed like the graph's ops
+                                  // (true only for convolutions); empty: low_precision_convs(graph).
+                                  // The latency table times a lone convolution as an inner one
   };
 
   // What a plan executes, one entry per step, in order (for tests, logs and profiles).

@@ -54,14 +54,18 @@ Calibration calibrate(const graph::Graph& graph,
   Calibration c;
   c.method = method;
   for (size_t f = 0; f < frames.size(); ++f) {
-    graph::run(graph, frames[f], nullptr, [&](size_t index, const torch::Tensor& y) {
-      const std::string& name = graph.values[graph.ops[index].output].name;
-      const double b = bound(y, method);
+    const auto record = [&](const std::string& value, const torch::Tensor& x, const std::string& what) {
+      const double b = bound(x, method);
       if (!std::isfinite(b))
-        throw Error("calibration", "frame " + std::to_string(f) + ": op '" + graph.ops[index].name +
-                                       "' produced a non-finite value");
-      auto [it, inserted] = c.ranges.emplace(name, b);
+        throw Error("calibration", "frame " + std::to_string(f) + ": " + what + " is not finite");
+      auto [it, inserted] = c.ranges.emplace(value, b);
       if (!inserted) it->second = std::max(it->second, b);
+    };
+    // The inputs too: a convolution reading one computes low when told to (FusedGraph::Options::low_convs).
+    for (const auto& [name, x] : frames[f])
+      if (graph.has_input(name)) record(graph.values[graph.input(name)].name, x, "input '" + name + "'");
+    graph::run(graph, frames[f], nullptr, [&](size_t index, const torch::Tensor& y) {
+      record(graph.values[graph.ops[index].output].name, y, "op '" + graph.ops[index].name + "' output");
       return y;
     });
   }

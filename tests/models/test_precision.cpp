@@ -131,6 +131,26 @@ TEST(Precision, WideLayersStayFloat32) {
     EXPECT_GT(converted, 0);  // the float32 residuals are converted once for their readers
   }
   EXPECT_THROW(FusedGraph(g, {.precision = Precision::Int8}), Error);  // no calibration
+  // Which convolutions compute low can be given (the latency table times a lone one so): the
+  // first layer too; marking an op that is not a convolution, or a list of another length, is an error.
+  FusedGraph::Options first;
+  first.precision = Precision::Int8;
+  first.calibration = calibrate(g, {in}, CalibrationMethod::Max);
+  first.low_convs = low_precision_convs(g);
+  for (size_t i = 0; i < g.ops.size(); ++i)
+    first.low_convs[i] = first.low_convs[i] || g.ops[i].name == "backbone.conv_first";
+  FusedGraph forced(g, first);
+  forced.run(in);
+  const auto conv_first = std::find_if(forced.steps().begin(), forced.steps().end(), [](const auto& s) {
+    return s.kind == "conv" && s.ops[0] == "backbone.conv_first";
+  });
+  ASSERT_NE(conv_first, forced.steps().end());
+  EXPECT_EQ(conv_first->precision, "int8");
+  FusedGraph::Options wrong = first;
+  wrong.low_convs.pop_back();
+  EXPECT_THROW(FusedGraph(g, wrong).run(in), Error);
+  wrong.low_convs = std::vector<bool>(g.ops.size(), true);
+  EXPECT_THROW(FusedGraph(g, wrong).run(in), Error);
 }
 
 // Every backbone, plain and with a RIT: INT8 and BF16 outputs on frames the calibration did not
