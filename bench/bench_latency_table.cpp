@@ -1,9 +1,10 @@
 // How well the latency table (models/latency_table.h) predicts what the fused path measures:
 // PAN x2 with a RIT at an LR size, its table measured and calibrated, then random subnets of its
-// elastic space predicted and measured side by side. Prints one JSON object: the table's size and
-// calibration, and the mean and largest absolute prediction error (%), with every pair.
+// elastic space predicted and measured side by side, in one precision. Prints one JSON object:
+// the table's size and calibration, and the mean and largest absolute prediction error (%), with
+// every pair.
 //
-//   bench_latency_table [--width 320] [--height 240] [--subnets 20] [--runs 5] [--threads 2]
+//   bench_latency_table [--width 320] [--height 240] [--subnets 20] [--runs 5] [--threads 2] [--precision int8]
 #include <torch/torch.h>
 
 #include <cmath>
@@ -21,10 +22,12 @@ using namespace cgsr;
 
 int main(int argc, char** argv) {
   int width = 320, height = 240, subnets = 20, runs = 5, threads = 2;
+  Precision precision = Precision::Fp32;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     const int v = std::atoi(argv[i + 1]);
-    if (flag == "--width") width = v;
+    if (flag == "--precision") precision = enum_from_name<Precision>(argv[i + 1]);
+    else if (flag == "--width") width = v;
     else if (flag == "--height") height = v;
     else if (flag == "--subnets") subnets = v;
     else if (flag == "--runs") runs = v;
@@ -41,22 +44,22 @@ int main(int argc, char** argv) {
   LatencyTableOptions options;
   options.runs = runs;
   options.check_subnets = 0;
-  const LatencyTable table = measure_latency_table(*net, space, width, height, options);
+  const LatencyTable table = measure_latency_table(*net, space, width, height, options, precision);
   std::mt19937_64 rng(7);
   double sum = 0, worst = 0;
   std::string pairs;
   for (int i = 0; i < subnets; ++i) {
     const graph::Graph g = subnet_graph(*net, space.sample(rng));
-    const double predicted = table.predict(g), measured = measure_graph_latency(g, width, height, runs);
+    const double predicted = table.predict(g), measured = measure_graph_latency(g, width, height, runs, precision);
     const double error = 100.0 * std::abs(predicted - measured) / measured;
     sum += error;
     worst = std::max(worst, error);
     pairs += (i ? ", " : "") + std::string("[") + std::to_string(predicted) + ", " + std::to_string(measured) + "]";
   }
-  std::printf("{\"lr_size\": [%d, %d], \"threads\": %d, \"convolution_shapes\": %zu, \"scale\": %.4f, "
-              "\"element_ns\": %.4f, \"offset_ms\": %.3f, \"subnets\": %d, \"mean_abs_error_percent\": %.2f, "
-              "\"max_abs_error_percent\": %.2f, \"predicted_measured_ms\": [%s]}\n",
-              width, height, threads, table.conv_ms.size(), table.scale, table.element_ns, table.offset_ms, subnets,
-              sum / subnets, worst, pairs.c_str());
+  std::printf("{\"precision\": \"%s\", \"lr_size\": [%d, %d], \"threads\": %d, \"convolution_shapes\": %zu, "
+              "\"scale\": %.4f, \"element_ns\": %.4f, \"offset_ms\": %.3f, \"subnets\": %d, "
+              "\"mean_abs_error_percent\": %.2f, \"max_abs_error_percent\": %.2f, \"predicted_measured_ms\": [%s]}\n",
+              enum_name(precision).c_str(), width, height, threads, table.conv_ms.size(), table.scale,
+              table.element_ns, table.offset_ms, subnets, sum / subnets, worst, pairs.c_str());
   return 0;
 }

@@ -68,16 +68,39 @@ std::vector<int64_t> widths_of(const graph::Layout& layout, const std::map<std::
   return {sums.begin(), sums.end()};
 }
 
-double time_conv(const ConvShape& c, int64_t w, int64_t h, int runs) {
+// A fused graph of `graph` in `precision` for timing: int8 calibrated on `inputs` (the ranges
+// change the values, not the time). `low_convs` as FusedGraph::Options has it.
+FusedGraph timing_graph(const graph::Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
+                        Precision precision, std::vector<bool> low_convs = {}) {
+  FusedGraph::Options o;
+  o.precision = precision;
+  o.low_convs = std::move(low_convs);
+  if (precision == Precision::Int8) o.calibration = calibrate(graph, {inputs}, CalibrationMethod::Max);
+  return FusedGraph(graph, o);
+}
+
+// A lone convolution of the shape, in `precision` when `low`.
+double time_conv(const ConvShape& c, int64_t w, int64_t h, int runs, Precision precision, bool low) {
   if (c.groups != 1) throw Error("latency table", "grouped convolutions are not timed", ErrorKind::Internal);
-  graph::Builder g;
-  const int x = g.input("x", graph::fixed_layout("x", c.in), c.factor * c.stride);
+  graph::Builder b;
+  const int x = b.input("x", graph::fixed_layout("x", c.in), c.factor * c.stride);
   const auto weight = torch::randn({c.out, c.in / c.groups, c.kernel, c.kernel}) * 0.1;
   const auto bias = torch::zeros({c.out});
-  g.output("y", g.conv("conv", x, weight, bias, c.padding, graph::fixed_layout("y", c.out), true, c.stride));
-  FusedGraph fused(g.finish());
-  const auto input = torch::rand({1, c.in, h * c.factor * c.stride, w * c.factor * c.stride});
-  return measure_latency([&] { fused.run({{"x", input}}); }, /*warmup=*/2, runs).median_ms;
+  b.output("y", b.conv("conv", x, weight, bias, c.padding, graph::fixed_layout("y", c.out), true, c.stride));
+  const graph::Graph g = b.finish();
+  const std::vector<std::pair<std::string, torch::Tensor>> inputs = {
+      {"x", torch::rand({1, c.in, h * c.factor * c.stride, w * c.factor * c.stride})}};
+  FusedGraph fused = timing_graph(g, inputs, low ? precision : Precision::Fp32, std::vector<bool>(g.ops.size(), low));
+  return measure_latency([&] { fused.run(inputs); }, /*warmup=*/2, runs).median_ms;
+}
+
+// Which convolutions of `graph` compute in `precision` (none in float32).
+std::vector<bool> low_convs_in(const graph::Graph& graph, Precision precision) {
+  return precision == Precision::Fp32 ? std::vector<bool>(graph.ops.size(), false) : low_precision_convs(graph);
+}
+
+std::string precision_key(const std::string& shape_key, Precision precision, bool low) {
+  return low ? shape_key + "_" + enum_name(precision) : shape_key;
 }
 
 // Solves the least-squares fit of y = a x0 + b x1 + c; false when degenerate.
@@ -110,9 +133,11 @@ std::string conv_shape_key(const graph::Graph& graph, const graph::Op& op) { ret
 
 std::pair<double, double> LatencyTable::features(const graph::Graph& graph) const {
   double conv = 0, elements = 0;
-  for (const auto& op : graph.ops) {
+  const std::vector<bool> low = low_convs_in(graph, precision);
+  for (size_t i = 0; i < graph.ops.size(); ++i) {
+    const auto& op = graph.ops[i];
     if (op.kind == graph::OpKind::Conv) {
-      const std::string key = conv_shape_key(graph, op);
+      const std::string key = precision_key(conv_shape_key(graph, op), precision, low[i]);
       const auto it = conv_ms.find(key);
       if (it == conv_ms.end())
         throw Error("latency table", "no time for " + op.name + " (" + key + "); the subnet is outside the table's space");
@@ -130,29 +155,34 @@ double LatencyTable::predict(const graph::Graph& graph) const {
   return scale * conv + element_ns * 1e-6 * elements + offset_ms;
 }
 
-double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs) {
-  FusedGraph fused(graph);
+double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs,
+                             Precision precision) {
   std::vector<std::pair<std::string, torch::Tensor>> inputs;
   for (const auto& [name, v] : graph.inputs) {
     const auto& value = graph.values[v];
     inputs.emplace_back(name, torch::rand({1, graph::layout_width(value.layout), lr_height * value.factor,
                                            lr_width * value.factor}));
   }
+  FusedGraph fused = timing_graph(graph, inputs, precision);
   return measure_latency([&] { fused.run(inputs); }, /*warmup=*/2, runs).median_ms;
 }
 
 LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace& space, int64_t lr_width,
-                                   int64_t lr_height, const LatencyTableOptions& options) {
+                                   int64_t lr_height, const LatencyTableOptions& options, Precision precision) {
   torch::NoGradGuard no_grad;
   LatencyTable table;
+  table.precision = precision;
   table.lr_width = lr_width;
   table.lr_height = lr_height;
   table.threads = torch::get_num_threads();
   const graph::Graph full = net.describe(false);
   std::map<std::string, std::vector<int64_t>> choices;
   for (const auto& gene : space.genes()) choices[gene.group] = gene.choices;
-  std::map<std::string, ConvShape> shapes;
-  for (const auto& op : full.ops) {
+  // Subnets keep the full network's first and last layers, so its wide convolutions are theirs.
+  const std::vector<bool> low = low_convs_in(full, precision);
+  std::map<std::string, std::pair<ConvShape, bool>> shapes;  // key -> shape, computes low
+  for (size_t i = 0; i < full.ops.size(); ++i) {
+    const auto& op = full.ops[i];
     if (op.kind != graph::OpKind::Conv) continue;
     ConvShape base = shape_of(full, op);
     for (int64_t in : widths_of(full.values[op.inputs[0]].layout, choices, {}))
@@ -160,13 +190,13 @@ LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace&
         ConvShape c = base;
         c.in = in;
         c.out = out;
-        shapes.emplace(c.key(), c);
+        shapes.emplace(precision_key(c.key(), precision, low[i]), std::make_pair(c, static_cast<bool>(low[i])));
       }
   }
   {
-    Progress progress("latency table", static_cast<int64_t>(shapes.size()));
+    Progress progress("latency table (" + enum_name(precision) + ")", static_cast<int64_t>(shapes.size()));
     for (const auto& [key, shape] : shapes) {
-      table.conv_ms[key] = time_conv(shape, lr_width, lr_height, options.runs);
+      table.conv_ms[key] = time_conv(shape.first, lr_width, lr_height, options.runs, precision, shape.second);
       progress.advance();
     }
   }
@@ -183,7 +213,7 @@ LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace&
     const graph::Graph g = subnet_graph(net, sub);
     const auto [conv, elements] = table.features(g);
     x.push_back({conv, elements * 1e-6, 1.0});
-    y.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs));
+    y.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs, precision));
     progress.advance();
   }
   std::array<double, 3> coef{};
@@ -200,7 +230,7 @@ LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace&
   for (const auto& sub : check_set) {
     const graph::Graph g = subnet_graph(net, sub);
     table.error.predicted_ms.push_back(table.predict(g));
-    table.error.measured_ms.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs));
+    table.error.measured_ms.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs, precision));
     progress.advance();
   }
   table.error.subnets = static_cast<int>(check_set.size());
@@ -216,7 +246,8 @@ LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace&
 nlohmann::ordered_json to_json(const LatencyTable& t) {
   nlohmann::ordered_json conv = nlohmann::ordered_json::object();
   for (const auto& [key, ms] : t.conv_ms) conv[key] = ms;
-  return {{"lr_size", {t.lr_width, t.lr_height}},
+  return {{"precision", t.precision},
+          {"lr_size", {t.lr_width, t.lr_height}},
           {"threads", t.threads},
           {"calibration", {{"scale", t.scale}, {"element_ns", t.element_ns}, {"offset_ms", t.offset_ms}}},
           {"error",
@@ -233,6 +264,7 @@ LatencyTable latency_table_from_json(const nlohmann::ordered_json& j, const std:
   try {
     const auto size = j.at("lr_size").get<std::vector<int64_t>>();
     if (size.size() != 2 || size[0] < 1 || size[1] < 1) throw Error(context + ": lr_size", "expected [width, height]");
+    if (j.contains("precision")) t.precision = j.at("precision").get<Precision>();  // absent: a float32 table
     t.lr_width = size[0];
     t.lr_height = size[1];
     t.threads = j.at("threads").get<int>();
@@ -255,6 +287,25 @@ LatencyTable latency_table_from_json(const nlohmann::ordered_json& j, const std:
     throw Error(context, std::string("malformed latency table: ") + e.what());
   }
   return t;
+}
+
+std::string latency_table_key(Precision precision) {
+  return precision == Precision::Fp32 ? "latency_table" : "latency_table_" + enum_name(precision);
+}
+
+std::map<Precision, LatencyTable> latency_tables_from(const nlohmann::ordered_json& extra, const std::string& context) {
+  std::map<Precision, LatencyTable> tables;
+  if (!extra.is_object()) return tables;
+  for (const auto& name : EnumNames<Precision>::names()) {
+    const Precision p = enum_from_name<Precision>(name);
+    const std::string key = latency_table_key(p);
+    if (!extra.contains(key)) continue;
+    LatencyTable t = latency_table_from_json(extra.at(key), context + ": " + key);
+    if (t.precision != p)
+      throw Error(context + ": " + key, "holds a " + enum_name(t.precision) + " table, not " + name);
+    tables.emplace(p, std::move(t));
+  }
+  return tables;
 }
 
 }  // namespace cgsr

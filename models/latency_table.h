@@ -10,7 +10,13 @@
 // what the sum misses: fusions, memory traffic between layers, the fixed cost of a run. Its error
 // on subnets it was not fitted on is recorded with the table.
 //
-//   LatencyTable table = measure_latency_table(*net, space, 320, 240, options);
+// A table is measured for one precision (precision.h). In bf16 or int8 the convolutions that
+// compute in it are timed so, and their keys end in the format ("..._f1_int8"); the wide ones
+// (low_precision_convs) keep float32 keys and times. A lone convolution is timed as an inner one
+// would run (FusedGraph::Options::low_convs), reading a float32 input it converts; the
+// calibration absorbs the difference.
+//
+//   LatencyTable table = measure_latency_table(*net, space, 320, 240, options, Precision::Int8);
 //   double ms = table.predict(subnet_graph(*net, sub));
 
 #include <cstdint>
@@ -22,6 +28,7 @@
 #include "core/config.h"
 #include "models/elastic.h"
 #include "models/graph.h"
+#include "models/precision.h"
 #include "models/sr_network.h"
 
 namespace cgsr {
@@ -43,6 +50,7 @@ struct PredictionError {
 };
 
 struct LatencyTable {
+  Precision precision = Precision::Fp32;
   int64_t lr_width = 0, lr_height = 0;
   int threads = 0;
   std::map<std::string, double> conv_ms;  // shape key -> median ms
@@ -55,18 +63,27 @@ struct LatencyTable {
   double predict(const graph::Graph& graph) const;
 };
 
-// "k3_i20_o40_s1_f1": a convolution's shape key.
+// "k3_i20_o40_s1_p1_g1_f1": a convolution's shape key (without a precision).
 std::string conv_shape_key(const graph::Graph& graph, const graph::Op& op);
 
-// Times every convolution shape the space's subnets can have, then calibrates on whole subnets.
+// Times every convolution shape the space's subnets can have, then calibrates on whole subnets,
+// all in `precision`.
 LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace& space, int64_t lr_width,
-                                   int64_t lr_height, const LatencyTableOptions& options);
+                                   int64_t lr_height, const LatencyTableOptions& options,
+                                   Precision precision = Precision::Fp32);
 
-// Measured fused-path latency (median ms) of a graph at an LR size: one input of the graph's
-// shape, `runs` timed runs after two warm-up runs.
-double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs);
+// Measured fused-path latency (median ms) of a graph at an LR size in `precision`: one random
+// input of the graph's shape (int8 calibrated on it), `runs` timed runs after two warm-up runs.
+double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs,
+                             Precision precision = Precision::Fp32);
 
 nlohmann::ordered_json to_json(const LatencyTable& table);
 LatencyTable latency_table_from_json(const nlohmann::ordered_json& j, const std::string& context);
+
+// Where a model file's provenance keeps the table of a precision: "latency_table" (float32),
+// "latency_table_int8", "latency_table_bf16".
+std::string latency_table_key(Precision precision);
+// Every table in a provenance's `extra`, by precision (empty when it has none).
+std::map<Precision, LatencyTable> latency_tables_from(const nlohmann::ordered_json& extra, const std::string& context);
 
 }  // namespace cgsr

@@ -33,6 +33,15 @@ struct EnumNames<Precision> {
   static constexpr const char* kind = "precision";
   static const std::vector<std::string>& names();  // fp32, bf16, int8
 };
+// A precision in JSON files is its name ("int8").
+template <class J, nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<J>::value, int> = 0>
+void to_json(J& j, Precision p) {
+  j = enum_name(p);
+}
+template <class J, nlohmann::detail::enable_if_t<nlohmann::detail::is_basic_json<J>::value, int> = 0>
+void from_json(const J& j, Precision& p) {
+  p = enum_from_name<Precision>(j.template get<std::string>());
+}
 
 enum class CalibrationMethod {
   Max,         // the largest |x| seen: nothing saturates, small values get coarse steps
