@@ -24,6 +24,15 @@ config::Schema<ElasticOptions> elastic_options_schema() {
   s.field("elastic_width", &ElasticOptions::elastic_width, "subnets may narrow layer groups");
   s.field("elastic_depth", &ElasticOptions::elastic_depth, "subnets may skip residual blocks");
   s.field("fixed_groups", &ElasticOptions::fixed_groups, "layer groups that always keep every channel");
+  s.field("precisions", &ElasticOptions::precisions,
+          "formats a subnet may run in (fp32, bf16, int8): a latency table for each, the search picks one");
+  s.validate([](const ElasticOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (o.precisions.empty() || o.precisions.front() != Precision::Fp32)
+      at.child("precisions").fail(node["precisions"], "must start with fp32 (the full network's format)");
+    for (size_t i = 1; i < o.precisions.size(); ++i)
+      if (std::find(o.precisions.begin(), o.precisions.begin() + i, o.precisions[i]) != o.precisions.begin() + i)
+        at.child("precisions").fail(node["precisions"], "lists " + enum_name(o.precisions[i]) + " twice");
+  });
   return s;
 }
 
@@ -49,6 +58,7 @@ ElasticSpace::ElasticSpace(const ArchSpec& spec, ElasticOptions options, std::ve
   if (sorted != expected)
     throw Error("elastic space", "the block order must list each of the network's " + std::to_string(spec_.blocks) +
                                      " blocks once");
+  if (options_.precisions.empty()) throw Error("elastic space: precisions", "lists no precision");
   const auto groups = layer_groups(spec_);
   for (const auto& g : options_.fixed_groups)
     if (std::none_of(groups.begin(), groups.end(), [&](const auto& x) { return x.first == g; }))
@@ -103,12 +113,18 @@ SubnetConfig ElasticSpace::sample(std::mt19937_64& rng, ShrinkLimits limits) con
   std::shuffle(all.begin(), all.end(), rng);
   sub.blocks.assign(all.begin(), all.begin() + blocks);
   std::sort(sub.blocks.begin(), sub.blocks.end());
+  if (options_.precisions.size() > 1) {
+    std::uniform_int_distribution<size_t> pick(0, options_.precisions.size() - 1);
+    sub.precision = options_.precisions[pick(rng)];
+  }
   return sub;
 }
 
 bool ElasticSpace::contains(const SubnetConfig& sub) const {
   if (!subnet_problems(spec_, sub).empty()) return false;
   if (static_cast<int>(sub.blocks.size()) < min_blocks()) return false;
+  if (std::find(options_.precisions.begin(), options_.precisions.end(), sub.precision) == options_.precisions.end())
+    return false;
   for (const auto& g : genes_) {
     const int64_t w = subnet_width(sub, g.group, g.full);
     if (std::find(g.choices.begin(), g.choices.end(), w) == g.choices.end()) return false;
@@ -133,6 +149,8 @@ SubnetConfig ElasticSpace::repair(SubnetConfig sub) const {
   }
   std::sort(blocks.begin(), blocks.end());
   sub.blocks = blocks;
+  if (std::find(options_.precisions.begin(), options_.precisions.end(), sub.precision) == options_.precisions.end())
+    sub.precision = options_.precisions.front();
   return sub;
 }
 

@@ -34,9 +34,14 @@ struct ElasticOptions {
   bool elastic_width = true;
   bool elastic_depth = true;
   std::vector<std::string> fixed_groups;  // layer groups that always keep every channel
+  // Formats a subnet may run in: a latency table is measured for each, and the search picks one
+  // per subnet. Training is always float32.
+  std::vector<Precision> precisions = {Precision::Fp32};
 };
 config::Schema<ElasticOptions> elastic_options_schema();
-CGSR_JSON_FIELDS(ElasticOptions, quantum, min_width_fraction, min_blocks, elastic_width, elastic_depth, fixed_groups)
+// Metadata written before a field existed reads it as its default.
+CGSR_JSON_FIELDS_WITH_DEFAULT(ElasticOptions, quantum, min_width_fraction, min_blocks, elastic_width, elastic_depth,
+                              fixed_groups, precisions)
 
 // How far a sample may shrink: the fraction of the way from the full width (0) to the smallest
 // (1), per dimension. Progressive shrinking opens these over the training.
@@ -64,16 +69,19 @@ class ElasticSpace {
   int total_blocks() const { return spec_.blocks; }
   int min_blocks() const;
 
+  // full() and smallest() run in float32 (the references, and what training runs).
   SubnetConfig full() const;
   // Every gene at its lowest choice within `limits`, the most important blocks kept.
   SubnetConfig smallest(ShrinkLimits limits = {}) const;
-  // Widths drawn uniformly among the allowed ones within `limits`, a block count uniformly, and
-  // which blocks uniformly among the subsets of that size.
+  // Widths drawn uniformly among the allowed ones within `limits`, a block count uniformly,
+  // which blocks uniformly among the subsets of that size, and a precision uniformly (when the
+  // options list more than one).
   SubnetConfig sample(std::mt19937_64& rng, ShrinkLimits limits = {}) const;
   // Whether the subnet is one of the space's (allowed widths, enough blocks).
   bool contains(const SubnetConfig& sub) const;
-  // Every width rounded to the nearest allowed one and the block count raised to the minimum
-  // (restoring the most important missing blocks): the nearest subnet in the space.
+  // Every width rounded to the nearest allowed one, the block count raised to the minimum
+  // (restoring the most important missing blocks) and a precision the space does not list
+  // replaced by its first: the nearest subnet in the space.
   SubnetConfig repair(SubnetConfig sub) const;
 
  private:

@@ -66,13 +66,16 @@ std::string subnet_key(const SubnetConfig& sub) {
     if (block && !kept_block(sub, block->first)) continue;  // a skipped block's widths change nothing
     key += "|" + group + "=" + std::to_string(width);
   }
+  if (sub.precision != Precision::Fp32) key += "|" + enum_name(sub.precision);
   return key;
 }
 
 nlohmann::ordered_json to_json(const SubnetConfig& sub) {
   nlohmann::ordered_json widths = nlohmann::ordered_json::object();
   for (const auto& [group, width] : sub.widths) widths[group] = width;
-  return {{"blocks", sub.blocks}, {"widths", widths}};
+  nlohmann::ordered_json j = {{"blocks", sub.blocks}, {"widths", widths}};
+  if (sub.precision != Precision::Fp32) j["precision"] = sub.precision;
+  return j;
 }
 
 SubnetConfig subnet_from_json(const nlohmann::ordered_json& j, const std::string& context) {
@@ -82,6 +85,7 @@ SubnetConfig subnet_from_json(const nlohmann::ordered_json& j, const std::string
     const auto& widths = j.at("widths");
     if (!widths.is_object()) throw Error(context + ": widths", "expected a map of layer group -> channels");
     for (const auto& [group, width] : widths.items()) sub.widths[group] = width.get<int64_t>();
+    if (j.contains("precision")) sub.precision = j.at("precision").get<Precision>();
   } catch (const nlohmann::json::exception& e) {
     throw Error(context, std::string("malformed subnet: ") + e.what());
   }

@@ -29,6 +29,7 @@
 #include "models/arch_spec.h"
 #include "models/channel_selection.h"
 #include "models/graph.h"
+#include "models/precision.h"
 #include "models/sr_network.h"
 
 namespace cgsr {
@@ -36,8 +37,12 @@ namespace cgsr {
 struct SubnetConfig {
   std::vector<int> blocks;                // kept blocks of the full network, ascending
   std::map<std::string, int64_t> widths;  // layer group -> leading channels kept; absent: all
+  Precision precision = Precision::Fp32;  // the format it runs in (the search's choice, precision.h);
+                                          // the graph and the weights do not depend on it
 
-  bool operator==(const SubnetConfig& o) const { return blocks == o.blocks && widths == o.widths; }
+  bool operator==(const SubnetConfig& o) const {
+    return blocks == o.blocks && widths == o.widths && precision == o.precision;
+  }
   bool operator!=(const SubnetConfig& o) const { return !(*this == o); }
 };
 
@@ -50,8 +55,8 @@ SubnetConfig full_subnet(const ArchSpec& spec);
 // The channels a subnet keeps of `group` in a network where the group is `full_width` wide.
 int64_t subnet_width(const SubnetConfig& sub, const std::string& group, int64_t full_width);
 
-// A canonical text: subnets that compute the same give equal keys ("b=0,2,3|features=32|...");
-// the widths of skipped blocks do not count.
+// A canonical text: subnets that compute the same give equal keys ("b=0,2,3|features=32|...",
+// then "|int8" when not float32); the widths of skipped blocks do not count.
 std::string subnet_key(const SubnetConfig& sub);
 
 nlohmann::ordered_json to_json(const SubnetConfig& sub);

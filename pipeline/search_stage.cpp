@@ -96,17 +96,25 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
                                           RunDir& run_dir) {
   Model elastic = load_model(options.model);
   const ElasticSpace space = elastic_space_from(elastic.network->spec(), elastic.provenance.extra, options.model);
-  if (!elastic.provenance.extra.contains("latency_table"))
-    throw Error(options.model, "has no latency table (train it with elastic.enabled)");
-  const LatencyTable table = latency_table_from_json(elastic.provenance.extra.at("latency_table"), options.model);
+  const std::map<Precision, LatencyTable> tables = latency_tables_from(elastic.provenance.extra, options.model);
+  for (Precision p : space.options().precisions)
+    if (!tables.count(p))
+      throw Error(options.model, "has no " + enum_name(p) + " latency table (train it with elastic.enabled" +
+                                     (p == Precision::Fp32 ? ")" : " and elastic.space.precisions listing it)"));
+  const LatencyTable& table = tables.at(Precision::Fp32);
   std::vector<RenderChannel> channels = elastic.network->input_channels();
   channels.push_back(RenderChannel::Edge);
   const Dataset data = open_for_channels(options.data, channels);
-  InferenceEvaluator evaluator(elastic.network, data, options.crops, table);
-  spdlog::info("search: {} elastic layer groups, {} blocks (at least {}); scoring on {} validation crops; latency "
-               "table at {}x{} (prediction error {:.1f}% mean, {:.1f}% max)",
-               space.genes().size(), space.total_blocks(), space.min_blocks(), evaluator.crops(), table.lr_width,
-               table.lr_height, table.error.mean_abs_percent, table.error.max_abs_percent);
+  InferenceEvaluator evaluator(elastic.network, data, options.crops, tables);
+  std::vector<std::string> precisions;
+  for (Precision p : space.options().precisions) precisions.push_back(enum_name(p));
+  spdlog::info("search: {} elastic layer groups, {} blocks (at least {}), precisions {}; scoring on {} validation "
+               "crops; latency tables at {}x{}",
+               space.genes().size(), space.total_blocks(), space.min_blocks(), join(precisions),
+               evaluator.crops(), table.lr_width, table.lr_height);
+  for (const auto& [p, t] : tables)
+    spdlog::info("search: {} latency table: prediction error {:.1f}% mean, {:.1f}% max", enum_name(p),
+                 t.error.mean_abs_percent, t.error.max_abs_percent);
 
   Candidate full;
   full.subnet = space.full();
@@ -162,11 +170,12 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   j["model"] = run_dir.file("model.cgsr").string();
   j["subnet_model"] = run_dir.file("subnet.cgsr").string();
   j["elastic"] = options.model;
-  j["latency_table"] = {{"lr_size", {table.lr_width, table.lr_height}},
-                        {"convolution_shapes", table.conv_ms.size()},
-                        {"prediction_error", {{"subnets", table.error.subnets},
-                                              {"mean_abs_percent", table.error.mean_abs_percent},
-                                              {"max_abs_percent", table.error.max_abs_percent}}}};
+  for (const auto& [p, t] : tables)
+    j[latency_table_key(p)] = {{"lr_size", {t.lr_width, t.lr_height}},
+                               {"convolution_shapes", t.conv_ms.size()},
+                               {"prediction_error", {{"subnets", t.error.subnets},
+                                                     {"mean_abs_percent", t.error.mean_abs_percent},
+                                                     {"max_abs_percent", t.error.max_abs_percent}}}};
   j["crops"] = evaluator.crops();
   j["full"] = candidate_json(full);
   j["hypervolume_reference"] = {{"latency_ms", latency_ref}, {"quality", quality_ref}};

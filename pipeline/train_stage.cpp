@@ -194,12 +194,15 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
   if (space) {
     const auto& lr = data.resolutions().front();
     network->eval();
-    const LatencyTable table = measure_latency_table(*network, *space, lr.width, lr.height, options.elastic.latency);
-    spdlog::info("{}: latency table of {} convolution shapes at {}x{}; prediction error on {} subnets: mean {:.1f}%, "
-                 "max {:.1f}%", name, table.conv_ms.size(), lr.width, lr.height, table.error.subnets,
-                 table.error.mean_abs_percent, table.error.max_abs_percent);
     extra["elastic"] = elastic_metadata(*space);
-    extra["latency_table"] = to_json(table);
+    for (Precision p : space->options().precisions) {
+      const LatencyTable table =
+          measure_latency_table(*network, *space, lr.width, lr.height, options.elastic.latency, p);
+      spdlog::info("{}: {} latency table of {} convolution shapes at {}x{}; prediction error on {} subnets: mean "
+                   "{:.1f}%, max {:.1f}%", name, enum_name(p), table.conv_ms.size(), lr.width, lr.height,
+                   table.error.subnets, table.error.mean_abs_percent, table.error.max_abs_percent);
+      extra[latency_table_key(p)] = to_json(table);
+    }
   }
   provenance.extra = extra;
   save_model(run_dir.file("model.cgsr"), *network, provenance);

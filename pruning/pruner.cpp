@@ -12,6 +12,7 @@
 #include "pruning/static_pruning.h"
 #include "render_data/patch_sampler.h"
 #include "search/evaluator.h"
+#include "search/search_loop.h"
 #include "train/elastic_training.h"
 
 namespace cgsr {
@@ -103,7 +104,18 @@ nlohmann::ordered_json prune(const std::filesystem::path& elastic_path, const st
   if (!elastic.provenance.extra.contains("latency_table"))
     throw Error(elastic_path.string(), "has no latency table (train it with elastic.enabled)");
   const LatencyTable table = latency_table_from_json(elastic.provenance.extra.at("latency_table"), elastic_path.string());
-  const SearchOutcome search = read_search(search_path);
+  SearchOutcome search = read_search(search_path);
+  // The hybrid runs in float32: the search's subnets in other precisions are priced as float32
+  // (same structure, quality within the search's quantization loss) and the front taken again.
+  const auto as_fp32 = [&](Candidate& c) {
+    if (c.subnet.precision == Precision::Fp32) return;
+    c.subnet.precision = Precision::Fp32;
+    c.key = subnet_key(c.subnet);
+    c.score.latency_ms = table.predict(subnet_graph(*elastic.network, c.subnet));
+  };
+  for (auto& c : search.front) as_fp32(c);
+  search.front = latency_front(search.front);
+  as_fp32(search.pick);
   const std::string name = options.name.empty() ? search.pick_name : options.name;
   const auto train_frames = data.frames(Split::Train);
   if (train_frames.empty()) throw Error(data.info().root.string(), "the data set has no training frames");

@@ -28,6 +28,13 @@ SubnetConfig mutate(const ElasticSpace& space, const SubnetConfig& sub, double r
     }
     out.blocks = blocks;
   }
+  const auto& precisions = space.options().precisions;
+  if (precisions.size() > 1 && u(rng) < rate) {  // another of the listed formats
+    std::vector<Precision> others;
+    for (Precision p : precisions)
+      if (p != out.precision) others.push_back(p);
+    out.precision = others[std::uniform_int_distribution<size_t>(0, others.size() - 1)(rng)];
+  }
   return space.repair(out);
 }
 
@@ -38,6 +45,7 @@ SubnetConfig crossover(const ElasticSpace& space, const SubnetConfig& a, const S
   for (const auto& gene : space.genes()) out.widths[gene.group] = (coin(rng) ? ra : rb).widths.at(gene.group);
   for (int block = 0; block < space.total_blocks(); ++block)
     if (keeps(coin(rng) ? ra : rb, block)) out.blocks.push_back(block);
+  if (space.options().precisions.size() > 1) out.precision = (coin(rng) ? ra : rb).precision;
   return space.repair(out);
 }
 

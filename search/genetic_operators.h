@@ -1,7 +1,8 @@
 #pragma once
 // Mutation and crossover of subnets (models/subnet.h) inside an elastic space: the genes are the
-// width of every elastic layer group and whether each residual block is kept. Results are
-// repaired into the space (allowed widths, enough blocks).
+// width of every elastic layer group, whether each residual block is kept, and the precision
+// when the space lists more than one. Results are repaired into the space (allowed widths,
+// enough blocks).
 
 #include <random>
 
@@ -10,7 +11,7 @@
 namespace cgsr {
 
 // Each gene changes with probability `rate`: a width moves one allowed step up or down, a block
-// is dropped or restored.
+// is dropped or restored, the precision becomes another listed one.
 SubnetConfig mutate(const ElasticSpace& space, const SubnetConfig& sub, double rate, std::mt19937_64& rng);
 
 // Each gene comes from `a` or `b` with equal probability.

@@ -8,7 +8,12 @@
 // shared by every subnet, so differences between subnets are not sampling noise. Each crop is run
 // with a margin of LR pixels around it that is cut off before scoring, so the crop's borders
 // (zero padding where the frame goes on) do not count.
+//
+// A subnet runs in its precision (SubnetConfig::precision): float32 in the interpreter, bf16 and
+// int8 on the fused path, int8 calibrated (99.99th percentile, models/precision.h) per subnet on
+// as many crops drawn from training frames. Its latency comes from that precision's table.
 
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -30,18 +35,27 @@ config::Schema<ValidationCropOptions> validation_crop_schema();
 
 class InferenceEvaluator : public Evaluator {
  public:
-  // `data` must carry the network's rendering channels (and edges, for edge PSNR).
-  InferenceEvaluator(SRNetwork network, const Dataset& data, const ValidationCropOptions& crops, LatencyTable table);
+  // `data` must carry the network's rendering channels (and edges, for edge PSNR). `tables`: a
+  // latency table per precision the subnets may run in (float32 at least).
+  InferenceEvaluator(SRNetwork network, const Dataset& data, const ValidationCropOptions& crops,
+                     std::map<Precision, LatencyTable> tables);
 
+  // Error naming the subnet when its precision has no latency table.
   SubnetScore evaluate(const SubnetConfig& subnet) override;
-  const LatencyTable& latency_table() const { return table_; }
-  int crops() const { return static_cast<int>(lr_color_.size(0)); }
+  const std::map<Precision, LatencyTable>& latency_tables() const { return tables_; }
+  int crops() const { return static_cast<int>(scored_.lr_color.size(0)); }
+
+  // Crops stacked [N, ...]; info, hr_color and edge_mask ([N,1,H,W]) undefined when not used.
+  struct Crops {
+    torch::Tensor lr_color, info, hr_color, edge_mask;
+  };
 
  private:
   SRNetwork network_;
-  LatencyTable table_;
+  std::map<Precision, LatencyTable> tables_;
   int margin_hr_ = 0;
-  torch::Tensor lr_color_, info_, hr_color_, edge_mask_;  // crops stacked [N, ...]; mask [N,1,H,W] or undefined
+  Crops scored_;       // from validation frames
+  Crops calibration_;  // from training frames, when a table is int8
 };
 
 }  // namespace cgsr

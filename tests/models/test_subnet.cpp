@@ -200,6 +200,45 @@ TEST(ElasticSpace, ChoicesSamplesAndRepair) {
   EXPECT_EQ(fixed.blocks, (std::vector<int>{0, 3}));
 }
 
+TEST(ElasticSpace, PrecisionIsAGeneWhenTheOptionsListSeveral) {
+  ElasticOptions options{4, 0.5, 2};
+  options.precisions = {Precision::Fp32, Precision::Int8};
+  const ElasticSpace space(small_pan(), options);
+  EXPECT_EQ(space.full().precision, Precision::Fp32);
+  EXPECT_EQ(space.smallest().precision, Precision::Fp32);
+  std::mt19937_64 rng(2);
+  std::set<Precision> drawn;
+  for (int i = 0; i < 40; ++i) {
+    const auto sub = space.sample(rng);
+    EXPECT_TRUE(space.contains(sub)) << subnet_key(sub);
+    drawn.insert(sub.precision);
+  }
+  EXPECT_EQ(drawn.size(), 2u);
+  // A precision the space does not list is outside it; repair gives the first listed.
+  SubnetConfig bf16 = space.full();
+  bf16.precision = Precision::Bf16;
+  EXPECT_FALSE(space.contains(bf16));
+  EXPECT_EQ(space.repair(bf16).precision, Precision::Fp32);
+  // Keys and files name a reduced precision; float32 ones read as before.
+  SubnetConfig int8 = space.full();
+  int8.precision = Precision::Int8;
+  EXPECT_EQ(subnet_key(int8), subnet_key(space.full()) + "|int8");
+  EXPECT_FALSE(to_json(space.full()).contains("precision"));
+  EXPECT_EQ(subnet_from_json(to_json(int8), "test"), int8);
+  EXPECT_NE(int8, space.full());
+  // The option starts with float32 and lists each format once.
+  const auto parse = [](const std::string& yaml) {
+    return config::parse_document(config::Document::parse(yaml, "elastic.yaml"), elastic_options_schema());
+  };
+  EXPECT_EQ(parse("precisions: [fp32, bf16, int8]\n").precisions.size(), 3u);
+  EXPECT_THROW(parse("precisions: [int8]\n"), Error);
+  EXPECT_THROW(parse("precisions: [fp32, int8, int8]\n"), Error);
+  // Metadata written before the option existed reads as float32 only.
+  nlohmann::ordered_json old = ElasticOptions{};
+  old.erase("precisions");
+  EXPECT_EQ(old.get<ElasticOptions>().precisions, std::vector<Precision>{Precision::Fp32});
+}
+
 TEST(ElasticSpace, MakeElasticSortsChannelsAndKeepsTheOutput) {
   const ArchSpec spec = small_pan();
   SRNetwork net = test::build_network(spec, 6);

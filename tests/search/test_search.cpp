@@ -98,6 +98,24 @@ TEST(GeneticOperators, StayInsideTheSpace) {
   EXPECT_EQ(subnet_key(crossover(space, a, a, rng)), subnet_key(a));
 }
 
+TEST(GeneticOperators, MutateAndCrossPrecisions) {
+  ElasticOptions options{4, 0.25, 2};
+  options.precisions = {Precision::Fp32, Precision::Bf16, Precision::Int8};
+  const ElasticSpace space(elastic_pan(), options);
+  std::mt19937_64 rng(4);
+  SubnetConfig a = space.full(), b = space.full();
+  b.precision = Precision::Int8;
+  std::set<Precision> mutated, crossed;
+  for (int i = 0; i < 60; ++i) {
+    const SubnetConfig m = mutate(space, a, 1.0, rng);
+    EXPECT_NE(m.precision, Precision::Fp32);  // at rate 1 the precision always changes
+    mutated.insert(m.precision);
+    crossed.insert(crossover(space, a, b, rng).precision);
+  }
+  EXPECT_EQ(mutated, (std::set<Precision>{Precision::Bf16, Precision::Int8}));
+  EXPECT_EQ(crossed, (std::set<Precision>{Precision::Fp32, Precision::Int8}));  // one parent's or the other's
+}
+
 TEST(Pareto, RanksCrowdingAndHypervolume) {
   // cost, quality: 0 and 1 on the front, 2 behind 0, 3 behind everything.
   const std::vector<double> cost = {1, 2, 1.5, 3}, quality = {1, 2, 0.5, 0};
@@ -235,7 +253,7 @@ TEST(InferenceEvaluator, ScoresSubnetsOfARealNetworkOnRenderedCrops) {
   crops.crops_per_frame = 2;
   crops.size = 12;
   crops.margin = 2;
-  InferenceEvaluator evaluator(net, data, crops, table);
+  InferenceEvaluator evaluator(net, data, crops, {{Precision::Fp32, table}});
   const int frames = std::min<int>(2, static_cast<int>(data.frames(Split::Val).size()));
   EXPECT_EQ(evaluator.crops(), 2 * frames);
   const SubnetScore full = evaluator.evaluate(space.full()), small = evaluator.evaluate(space.smallest());
@@ -244,4 +262,63 @@ TEST(InferenceEvaluator, ScoresSubnetsOfARealNetworkOnRenderedCrops) {
   EXPECT_GT(full.latency_ms, 0);
   // Deterministic: the same subnet scores the same.
   EXPECT_EQ(evaluator.evaluate(space.smallest()).psnr, small.psnr);
+}
+
+TEST(InferenceEvaluator, ScoresAnInt8SubnetOnTheFusedPathWithItsOwnLatencyTable) {
+  seed_everything(6);
+  const Dataset data = Dataset::open(test::tiny_data());
+  ArchSpec spec = elastic_pan(2);
+  SRNetwork net(spec);
+  net->eval();
+  ElasticOptions options{4, 0.25, 1};
+  options.precisions = {Precision::Fp32, Precision::Int8};
+  const ElasticSpace space(spec, options);
+  LatencyTableOptions latency;
+  latency.calibration_subnets = 2;
+  latency.check_subnets = 1;
+  latency.runs = 1;
+  latency.subnet_runs = 1;
+  std::map<Precision, LatencyTable> tables;
+  for (Precision p : options.precisions) tables[p] = measure_latency_table(*net, space, 32, 24, latency, p);
+  // The int8 table times the inner convolutions in int8 and the wide first and last in float32.
+  int int8_keys = 0;
+  for (const auto& [key, ms] : tables.at(Precision::Int8).conv_ms)
+    int8_keys += key.size() > 5 && key.substr(key.size() - 5) == "_int8";
+  EXPECT_GT(int8_keys, 0);
+  EXPECT_LT(int8_keys, static_cast<int>(tables.at(Precision::Int8).conv_ms.size()));
+  for (const auto& [key, ms] : tables.at(Precision::Fp32).conv_ms) EXPECT_EQ(key.find("int8"), std::string::npos);
+  // Both kept in a provenance, read back by precision; a table under another's key is refused.
+  nlohmann::ordered_json extra;
+  for (const auto& [p, t] : tables) extra[latency_table_key(p)] = to_json(t);
+  const auto back = latency_tables_from(extra, "model.cgsr");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back.at(Precision::Int8).precision, Precision::Int8);
+  EXPECT_EQ(back.at(Precision::Int8).conv_ms, tables.at(Precision::Int8).conv_ms);
+  extra["latency_table_bf16"] = extra["latency_table_int8"];
+  EXPECT_THROW(latency_tables_from(extra, "model.cgsr"), Error);
+  ValidationCropOptions crops;
+  crops.frames = 2;
+  crops.crops_per_frame = 2;
+  crops.size = 12;
+  crops.margin = 2;
+  InferenceEvaluator evaluator(net, data, crops, tables);
+  SubnetConfig int8 = space.smallest();
+  int8.precision = Precision::Int8;
+  const SubnetScore f = evaluator.evaluate(space.smallest()), q = evaluator.evaluate(int8);
+  // The same subnet: its int8 output is close to float32's, not equal (it ran quantized).
+  EXPECT_NE(q.psnr, f.psnr);
+  EXPECT_NEAR(q.psnr, f.psnr, 0.5);
+  EXPECT_EQ(q.macs, f.macs);
+  EXPECT_EQ(q.latency_ms, tables.at(Precision::Int8).predict(subnet_graph(*net, int8)));
+  EXPECT_EQ(evaluator.evaluate(int8).psnr, q.psnr);  // calibration and scoring are deterministic
+  // A precision without a table is an error naming the subnet.
+  SubnetConfig bf16 = int8;
+  bf16.precision = Precision::Bf16;
+  try {
+    evaluator.evaluate(bf16);
+    FAIL() << "scored without a bf16 latency table";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("|bf16"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no bf16 latency table"), std::string::npos) << e.what();
+  }
 }
