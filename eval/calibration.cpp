@@ -14,18 +14,26 @@ config::Schema<CalibrationOptions> calibration_schema_fields() {
   return s;
 }
 
-Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const CalibrationOptions& options) {
+std::vector<std::vector<std::pair<std::string, torch::Tensor>>> calibration_inputs(const SRNetworkImpl& net,
+                                                                                   const graph::Graph& graph,
+                                                                                   const Dataset& data,
+                                                                                   const CalibrationOptions& options) {
   const std::vector<int> frames = spread_frames(data.frames(split_from_name(options.split)), options.frames);
   if (frames.empty())
     throw Error(data.info().root.string(), "no " + options.split + " frames to calibrate int8 activations on");
-  net.eval();
-  const graph::Graph g = net.describe();
   std::vector<std::vector<std::pair<std::string, torch::Tensor>>> inputs;
   for (int frame : frames) {
     const Batch b = frame_batch(data, frame, net.spec().scale, net.input_channels(), net.depth_encoding());
-    inputs.push_back(network_inputs(g, b.lr_color, net.info_input(b)));
+    inputs.push_back(network_inputs(graph, b.lr_color, net.info_input(b)));
   }
-  spdlog::info("calibrating int8 activations of {} on {} {} frame(s) ({})", spec_summary(net.spec()), frames.size(),
+  return inputs;
+}
+
+Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const CalibrationOptions& options) {
+  net.eval();
+  const graph::Graph g = net.describe();
+  const auto inputs = calibration_inputs(net, g, data, options);
+  spdlog::info("calibrating int8 activations of {} on {} {} frame(s) ({})", spec_summary(net.spec()), inputs.size(),
                options.split, enum_name(options.method));
   return calibrate(g, inputs, options.method);
 }

@@ -22,8 +22,16 @@ struct CalibrationOptions {
 };
 config::Schema<CalibrationOptions> calibration_schema_fields();
 
+// What a network reads on the calibration frames `options` pick of `data`: per frame, its graph
+// inputs (network_inputs of `graph`, a graph of `net` or of a subnet of it). Error naming the
+// data set when the split has no frames.
+std::vector<std::vector<std::pair<std::string, torch::Tensor>>> calibration_inputs(const SRNetworkImpl& net,
+                                                                                   const graph::Graph& graph,
+                                                                                   const Dataset& data,
+                                                                                   const CalibrationOptions& options);
+
 // The ranges of `net`'s activations on whole frames of `data` (LR colour and the rendering
-// information the network reads). Error naming the data set when the split has no frames.
+// information the network reads).
 Calibration calibrate_network(SRNetworkImpl& net, const Dataset& data, const CalibrationOptions& options);
 
 // A network's row name in a precision: "<network> int8" (fp32 keeps the network's name); and back.

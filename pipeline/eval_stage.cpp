@@ -55,6 +55,15 @@ std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::str
   return std::make_unique<NetworkUpscaler>(display, model.network);
 }
 
+std::unique_ptr<Upscaler> upscaler_in_precision(const Upscaler& upscaler, Precision precision, const Dataset& data,
+                                                const CalibrationOptions& calibration) {
+  if (const auto* network = dynamic_cast<const NetworkUpscaler*>(&upscaler))
+    return network_in_precision(*network, precision, data, calibration);
+  if (const auto* hybrid = dynamic_cast<const HybridUpscaler*>(&upscaler))
+    return hybrid_in_precision(*hybrid, precision, data, calibration);
+  return nullptr;
+}
+
 namespace {
 // The data set loading only the channels the upscalers read, plus motion vectors for the
 // temporal error and edges for the PSNR on geometry edges (evaluate() reads them at HR):
@@ -67,21 +76,19 @@ Dataset open_for(const std::string& path, const std::vector<std::unique_ptr<Upsc
   return open_for_channels(path, needed);
 }
 
-// Every network among `upscalers` in each of `precisions`, next to each other ("name int8");
-// classic upscalers and hybrids (their patterns run in float32) once.
+// Every network and hybrid among `upscalers` in each of `precisions`, next to each other
+// ("name int8"); classic upscalers once.
 std::vector<std::unique_ptr<Upscaler>> in_precisions(std::vector<std::unique_ptr<Upscaler>> upscalers,
                                                      const std::vector<Precision>& precisions, const Dataset& data,
                                                      const CalibrationOptions& calibration) {
   if (precisions == std::vector{Precision::Fp32}) return upscalers;
   std::vector<std::unique_ptr<Upscaler>> out;
   for (auto& u : upscalers) {
-    auto* network = dynamic_cast<NetworkUpscaler*>(u.get());
-    if (!network) {
-      if (u->cost(1, 1)) spdlog::warn("{}: runs in fp32 only (a hybrid's patterns are not quantized)", u->name());
-      out.push_back(std::move(u));
-      continue;
-    }
-    for (Precision p : precisions) out.push_back(network_in_precision(*network, p, data, calibration));
+    std::vector<std::unique_ptr<Upscaler>> formats;
+    for (Precision p : precisions)
+      if (auto in = upscaler_in_precision(*u, p, data, calibration)) formats.push_back(std::move(in));
+    if (formats.empty()) formats.push_back(std::move(u));
+    for (auto& f : formats) out.push_back(std::move(f));
   }
   return out;
 }

@@ -36,6 +36,11 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
 // Builds the upscaler for one `models` entry: a model file or a classic upscaler name.
 std::unique_ptr<Upscaler> make_upscaler(const std::string& entry, const std::string& name, int scale);
 
+// A network or hybrid upscaler in `precision` on the fused path (named "<name> int8"), INT8
+// calibrated on `data` as `calibration` says; null for a classic upscaler (it has no network).
+std::unique_ptr<Upscaler> upscaler_in_precision(const Upscaler& upscaler, Precision precision, const Dataset& data,
+                                                const CalibrationOptions& calibration);
+
 // The image comparisons of an eval run directory after the fact (`cgsr report --frames`): its
 // config.yaml names the data set and the models, its results.json the frames evaluated.
 std::vector<ComparisonImage> compare_eval_run(const std::filesystem::path& run, const ComparisonOptions& options,

@@ -699,8 +699,7 @@ class Pipeline {
       if (e.precision != Precision::Fp32) {
         const std::string network = network_of_row(e.name, e.precision);
         const auto base = make_upscaler(files.at(network).string(), network, backbone_.scale);
-        upscalers.push_back(network_in_precision(dynamic_cast<const NetworkUpscaler&>(*base), e.precision, *data_,
-                                                 options_.calibration));
+        upscalers.push_back(upscaler_in_precision(*base, e.precision, *data_, options_.calibration));
         continue;
       }
       const auto file = files.find(e.name);

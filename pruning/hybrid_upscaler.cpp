@@ -1,5 +1,6 @@
 #include "pruning/hybrid_upscaler.h"
 
+#include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -9,7 +10,9 @@
 
 namespace cgsr {
 
-HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std::move(name)), model_(std::move(model)) {
+HybridUpscaler::HybridUpscaler(std::string name, HybridModel model, Precision precision,
+                               const PatternCalibration& calibration)
+    : name_(std::move(name)), model_(std::move(model)) {
   model_.network->eval();
   model_.samplers->eval();
   sampler_channels_ = model_.samplers->options().render_channels();
@@ -17,7 +20,7 @@ HybridUpscaler::HybridUpscaler(std::string name, HybridModel model) : name_(std:
   for (auto c : sampler_channels_)
     if (std::find(channels_.begin(), channels_.end(), c) == channels_.end()) channels_.push_back(c);
   std::sort(channels_.begin(), channels_.end());
-  patterns_ = std::make_unique<PatternNetworks>(*model_.network, model_.pool);
+  patterns_ = std::make_unique<PatternNetworks>(*model_.network, model_.pool, precision, calibration);
   usage_.assign(model_.pool.size(), 0);
 }
 
@@ -94,6 +97,20 @@ std::optional<Complexity> HybridUpscaler::cost(int64_t lr_width, int64_t lr_heig
   c.params += sampler.params;
   c.macs += sampler.macs;
   return c;
+}
+
+std::unique_ptr<HybridUpscaler> hybrid_in_precision(const HybridUpscaler& hybrid, Precision precision,
+                                                    const Dataset& data, const CalibrationOptions& options) {
+  PatternCalibration calibration;
+  calibration.method = options.method;
+  if (precision == Precision::Int8) {
+    const SRNetworkImpl& net = *hybrid.model().network;
+    calibration.frames = calibration_inputs(net, net.describe(), data, options);
+    spdlog::info("calibrating int8 activations of {}'s {} patterns on {} {} frame(s) ({})", hybrid.name(),
+                 hybrid.model().pool.size(), calibration.frames.size(), options.split, enum_name(options.method));
+  }
+  return std::make_unique<HybridUpscaler>(precision_row_name(hybrid.name(), precision), hybrid.model(), precision,
+                                          calibration);
 }
 
 std::unique_ptr<Upscaler> make_hybrid_upscaler(const std::filesystem::path& path, const std::string& name) {

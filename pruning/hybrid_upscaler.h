@@ -9,10 +9,14 @@
 // upscale() call when it is the frame just before (a renderer calling it frame after frame),
 // else none (its change is taken as zero). reset_history() forgets both: a scene cut, where the
 // frame index goes on but the content does not.
+//
+// The patterns run in float32 unless a precision is given (pattern_networks.h); the choice
+// always runs in float32 (a few thousand MACs).
 
 #include <chrono>
 #include <memory>
 
+#include "eval/calibration.h"
 #include "eval/upscaler.h"
 #include "pruning/hybrid_model.h"
 #include "pruning/pattern_networks.h"
@@ -21,12 +25,14 @@ namespace cgsr {
 
 class HybridUpscaler : public Upscaler {
  public:
-  HybridUpscaler(std::string name, HybridModel model);
+  HybridUpscaler(std::string name, HybridModel model, Precision precision = Precision::Fp32,
+                 const PatternCalibration& calibration = {});
 
   std::string name() const override { return name_; }
   int scale() const override { return model_.network->spec().scale; }
   std::vector<RenderChannel> channels() const override { return channels_; }
   DepthEncoding depth_encoding() const override { return model_.network->depth_encoding(); }
+  Precision precision() const override { return patterns_->precision(); }
   torch::Tensor upscale(const Batch& batch) override;
   // MACs: the mean over the frames upscaled so far (the widest pattern's before any); params:
   // what the model holds (the static network and the sampler).
@@ -57,6 +63,11 @@ class HybridUpscaler : public Upscaler {
   bool chose_with_previous_ = false;     // the last choose() saw a previous frame
   std::optional<PatternChoice> choice_;  // of the last upscale()
 };
+
+// `hybrid` with every pattern in `precision`, named by precision_row_name ("... int8"); INT8
+// calibrates each pattern on `data` as `options` say.
+std::unique_ptr<HybridUpscaler> hybrid_in_precision(const HybridUpscaler& hybrid, Precision precision,
+                                                    const Dataset& data, const CalibrationOptions& options);
 
 // Loads a hybrid-pruned model file as an upscaler; the display name defaults to the one recorded
 // in the file (provenance.extra.name) or the file's stem.

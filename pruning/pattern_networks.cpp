@@ -6,7 +6,9 @@
 
 namespace cgsr {
 
-PatternNetworks::PatternNetworks(const SRNetworkImpl& net, PatternPool pool) : pool_(std::move(pool)) {
+PatternNetworks::PatternNetworks(const SRNetworkImpl& net, PatternPool pool, Precision precision,
+                                 const PatternCalibration& calibration)
+    : pool_(std::move(pool)), precision_(precision) {
   CGSR_CHECK(pool_.spec == net.spec(), "pattern networks: the pool belongs to another network");
   torch::NoGradGuard no_grad;
   for (const auto& pattern : pool_.patterns) {
@@ -17,6 +19,10 @@ PatternNetworks::PatternNetworks(const SRNetworkImpl& net, PatternPool pool) : p
       if (op.scale.defined()) op.scale = op.scale.detach().clone();
       if (op.shift.defined()) op.shift = op.shift.detach().clone();
     }
+    FusedGraph::Options o;
+    o.precision = precision;
+    if (precision == Precision::Int8) o.calibration = calibrate(g, calibration.frames, calibration.method);
+    options_.push_back(std::move(o));
     graphs_.push_back(std::move(g));
   }
   fused_.resize(graphs_.size());
@@ -34,7 +40,7 @@ torch::Tensor PatternNetworks::run(int k, const torch::Tensor& lr_color, const t
   // Every pattern is built at the first run: an engine loads all patterns before its first frame,
   // so switching to a pattern never pays for building it (and is never timed doing so).
   if (!fused_[k])
-    for (int p = 0; p < size(); ++p) fused_[p] = std::make_unique<FusedGraph>(graphs_[p]);
+    for (int p = 0; p < size(); ++p) fused_[p] = std::make_unique<FusedGraph>(graphs_[p], options_[p]);
   return fused_[k]->run(lr_color, info);
 }
 

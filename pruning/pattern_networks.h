@@ -22,14 +22,24 @@
 
 namespace cgsr {
 
+// How INT8 patterns are calibrated: the frames' graph inputs (each pattern's graph reads the same
+// names) and the method.
+struct PatternCalibration {
+  std::vector<std::vector<std::pair<std::string, torch::Tensor>>> frames;
+  CalibrationMethod method = CalibrationMethod::Percentile;
+};
+
 class PatternNetworks {
  public:
   // Reads `net`'s weights now (later changes to the network are not seen). The pool must
-  // belong to the network (pool.spec).
-  PatternNetworks(const SRNetworkImpl& net, PatternPool pool);
+  // belong to the network (pool.spec). Every pattern runs in `precision` (bf16, int8: the wide
+  // layers stay float32, models/fused_graph.h); int8 calibrates each pattern's own graph.
+  PatternNetworks(const SRNetworkImpl& net, PatternPool pool, Precision precision = Precision::Fp32,
+                  const PatternCalibration& calibration = {});
   ~PatternNetworks();
 
   int size() const { return pool_.size(); }
+  Precision precision() const { return precision_; }
   const PatternPool& pool() const { return pool_; }
 
   // The subnet graph of pattern k.
@@ -44,6 +54,8 @@ class PatternNetworks {
  private:
   PatternPool pool_;
   std::vector<graph::Graph> graphs_;
+  Precision precision_;
+  std::vector<FusedGraph::Options> options_;  // per pattern
   std::vector<std::unique_ptr<FusedGraph>> fused_;  // all built at the first run
 };
 

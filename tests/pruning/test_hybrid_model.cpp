@@ -142,3 +142,31 @@ TEST(HybridModel, TheChoiceFollowsTheRenderingInformation) {
   EXPECT_NEAR(static_cast<double>(up.cost(6, 5)->macs - h.samplers->macs()), static_cast<double>(expected), 1.0);
   EXPECT_EQ(up.usage(), (std::vector<int64_t>{1, 0, 1}));
 }
+
+// In int8 every pattern runs quantized, calibrated on its own graph; the choice is the float32
+// one's, and the output stays near float32's.
+TEST(HybridModel, PatternsRunInInt8EachCalibratedOnItsOwnGraph) {
+  torch::manual_seed(23);
+  const HybridModel h = make_hybrid();
+  PatternCalibration calibration;
+  const graph::Graph g = h.network->describe();
+  for (int i = 0; i < 4; ++i) {
+    const Batch f = frame(10 + i);
+    calibration.frames.push_back(network_inputs(g, f.lr_color, h.network->info_input(f)));
+  }
+  HybridUpscaler fp32("h", h), int8("h int8", h, Precision::Int8, calibration);
+  EXPECT_EQ(int8.precision(), Precision::Int8);
+  EXPECT_EQ(fp32.precision(), Precision::Fp32);
+  for (int i = 0; i < 3; ++i) {
+    const Batch f = frame(20 + i);
+    const auto reference = fp32.upscale(f), quantized = int8.upscale(f);
+    EXPECT_EQ(int8.frame_choice()->pattern, fp32.frame_choice()->pattern);
+    ASSERT_TRUE(torch::isfinite(quantized).all().item<bool>());
+    EXPECT_FALSE(torch::equal(quantized, reference));  // it did run quantized
+    const double mse = (quantized - reference).square().mean().item<double>();
+    const double peak = reference.abs().max().item<double>();
+    EXPECT_GT(10 * std::log10(peak * peak / mse), 25.0);
+  }
+  // Without calibration frames an int8 hybrid cannot be built.
+  EXPECT_THROW(HybridUpscaler("h int8", h, Precision::Int8), Error);
+}
