@@ -115,8 +115,9 @@ TEST(Verification, EverySubnetOnASearchFrontExportsAndMatchesInOnnxRuntime) {
   ValidationCropOptions crops;
   crops.frames = 1;
   crops.size = 16;
-  InferenceEvaluator evaluator(elastic.network, data, crops,
-                               measure_latency_table(*elastic.network, elastic.space, 32, 24, latency));
+  InferenceEvaluator evaluator(
+      elastic.network, data, crops,
+      {{Precision::Fp32, measure_latency_table(*elastic.network, elastic.space, 32, 24, latency)}});
   SearchOptions options;
   options.population = 8;
   options.generations = 2;
