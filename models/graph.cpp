@@ -323,7 +323,7 @@ torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, c
 
 std::vector<std::pair<std::string, torch::Tensor>> run(
     const Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
-    std::vector<double>* op_ms, const OpObserver& observer) {
+    std::vector<double>* op_ms, const OpObserver& observer, const ConvInputHook& conv_input) {
   if (op_ms) op_ms->assign(graph.ops.size(), 0.0);
   std::vector<torch::Tensor> values(graph.values.size());
   for (const auto& [name, v] : graph.inputs) {
@@ -346,7 +346,8 @@ std::vector<std::pair<std::string, torch::Tensor>> run(
     torch::Tensor y;
     switch (op.kind) {
       case OpKind::Conv:
-        y = torch::conv2d(in(0), op.weight, op.bias, op.stride, op.padding, op.dilation, op.groups);
+        y = torch::conv2d(conv_input ? conv_input(index, in(0)) : in(0), op.weight, op.bias, op.stride, op.padding,
+                          op.dilation, op.groups);
         break;
       case OpKind::Relu: y = torch::relu(in(0)); break;
       case OpKind::LeakyRelu: y = torch::leaky_relu(in(0), op.negative_slope); break;

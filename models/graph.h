@@ -198,11 +198,15 @@ torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, c
 // ops see (the output itself, or e.g. a masked copy). Lets callers observe or adjust activations
 // (pruning: activation importance, per-sample channel patterns) without another interpreter.
 using OpObserver = std::function<torch::Tensor(size_t op_index, const torch::Tensor& output)>;
+// Called before each convolution with its index and input; returns what the convolution reads
+// (the input itself, or e.g. the input rounded as INT8 would: models/precision.h). Other readers
+// of the same value still see it unchanged.
+using ConvInputHook = std::function<torch::Tensor(size_t op_index, const torch::Tensor& input)>;
 
 // Executes the graph. `inputs` maps graph input names to tensors; returns every graph output.
 // With `op_ms`, also the wall time of each op in milliseconds (indexed like graph.ops).
 std::vector<std::pair<std::string, torch::Tensor>> run(
     const Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
-    std::vector<double>* op_ms = nullptr, const OpObserver& observer = {});
+    std::vector<double>* op_ms = nullptr, const OpObserver& observer = {}, const ConvInputHook& conv_input = {});
 
 }  // namespace cgsr::graph

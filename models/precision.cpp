@@ -116,6 +116,25 @@ Calibration calibration_from_json(const nlohmann::json& j, const std::string& co
   }
 }
 
+std::vector<std::pair<std::string, torch::Tensor>> run_fake_int8(
+    const graph::Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
+    const Calibration& calibration) {
+  const std::vector<bool> low = low_precision_convs(graph);
+  graph::Graph g = graph;  // shares the tensors; low convolutions get rounded weights
+  std::vector<double> input_steps(g.ops.size(), 0);
+  for (size_t i = 0; i < g.ops.size(); ++i) {
+    if (!low[i]) continue;
+    auto& op = g.ops[i];
+    input_steps[i] = int8_scale(calibration.range(g.values[op.inputs[0]].name));
+    const torch::Tensor steps = int8_channel_scales(op.weight);
+    op.weight = torch::fake_quantize_per_channel_affine(op.weight, steps, torch::zeros_like(steps, torch::kInt), 0,
+                                                        -127, 127);
+  }
+  return graph::run(g, inputs, nullptr, {}, [&](size_t op, const torch::Tensor& x) {
+    return low[op] ? torch::fake_quantize_per_tensor_affine(x, input_steps[op], 0, -127, 127) : x;
+  });
+}
+
 float int8_scale(double range) {
   // A value that was always 0 still gets a positive step (every q is 0 then).
   return static_cast<float>(std::max(range, 1e-12) / 127.0);

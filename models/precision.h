@@ -81,6 +81,17 @@ Calibration calibrate(const graph::Graph& graph,
                       const std::vector<std::vector<std::pair<std::string, torch::Tensor>>>& frames,
                       CalibrationMethod method);
 
+// INT8 simulated in float32 (fake quantization), for quantization-aware fine-tuning: runs
+// `graph` (graph::run) with every low-precision convolution (low_precision_convs) reading its
+// input rounded to that value's calibrated step and its weight rounded per output channel, both
+// saturated at 127 steps, as the fused INT8 path computes them. Gradients pass the rounding
+// unchanged inside the range and are zero outside it (the straight-through estimator), so a
+// network trained through it learns weights that survive the rounding. Differentiable when the
+// graph's tensors are (subnet_graph with `differentiable`).
+std::vector<std::pair<std::string, torch::Tensor>> run_fake_int8(
+    const graph::Graph& graph, const std::vector<std::pair<std::string, torch::Tensor>>& inputs,
+    const Calibration& calibration);
+
 // The INT8 step for a tensor whose values lie within [-range, range].
 float int8_scale(double range);
 // round(x / scale) saturated to [-127, 127], as int8; and back (q * scale, float32).

@@ -13,6 +13,7 @@
 #include "models/model_source.h"
 #include "pipeline/distributed_run.h"
 #include "render_data/dataset.h"
+#include "train/quantization_aware.h"
 
 namespace cgsr {
 
@@ -35,6 +36,13 @@ config::Schema<TrainOptions> train_schema_with(
   s.field("name", &TrainOptions::name, "display name in reports");
   add_enhancement(s);
   s.section("distill", &TrainOptions::distill, distill_schema(), "learn a teacher network's output too");
+  config::Schema<QuantizationAwareOptions> qat;
+  qat.field("enabled", &QuantizationAwareOptions::enabled, "train and validate through simulated INT8");
+  qat.section("calibration", &QuantizationAwareOptions::calibration, calibration_schema_fields(),
+              "the frames the INT8 activation ranges are measured on, before training");
+  s.section("quantization_aware", &TrainOptions::quantization_aware, qat,
+            "quantization-aware fine-tuning, for a network whose post-training INT8 loses too much");
+  s.omit_when("quantization_aware", [](const TrainOptions& o) { return !o.quantization_aware.enabled; });
   s.section("schedule", &TrainOptions::schedule, schedule_schema(), "optimization schedule");
   s.section("loss", &TrainOptions::loss, loss_schema(), "CGSR loss weights");
   s.field("resume", &TrainOptions::resume, "continue from checkpoint.pt in the run directory");
@@ -119,6 +127,8 @@ NetworkToTrain network_to_train(const TrainOptions& options) {
     t.stage = "cg-enhanced";
   }
   if (options.elastic.enabled) {
+    if (options.quantization_aware.enabled)
+      throw Error("train: quantization_aware", "an elastic network's subnets train in float32; remove one of the two");
     if (options.distill.enabled())
       throw Error("train: distill", "an elastic network distils from its own full network; remove 'distill'");
     ElasticNetwork elastic = make_elastic(*t.network, options.elastic.space);
@@ -159,6 +169,14 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
     Model teacher = load_model(options.distill.teacher);
     hooks = distillation_hooks(teacher.network, options.distill.weight, options.loss.image_norm);
     extra["teacher"] = options.distill.teacher;
+  }
+  if (options.quantization_aware.enabled) {
+    network->eval();
+    const Calibration calibration = calibrate_network(*network, data, options.quantization_aware.calibration);
+    network->train();
+    hooks = quantization_aware(hooks, network, calibration);
+    extra["quantization_aware"] = calibration_json(calibration);
+    spdlog::info("{}: quantization-aware: training and validating through simulated int8", name);
   }
   Trainer trainer(network, data, options.schedule, options.loss, {}, hooks);
   std::unique_ptr<distributed::World> world;

@@ -4,12 +4,14 @@
 // geometry head, inherited weights) and trains that; with `elastic`, trains the network as an
 // elastic network whose subnets all work and measures its latency table (the elastic stage);
 // with `distill`, learns a teacher's output beside the HR frame. Writes model.cgsr (best
-// validation weights), last.cgsr, checkpoint.pt (for --resume) and results.json.
+// validation weights), last.cgsr, checkpoint.pt (for --resume) and results.json. With
+// `quantization_aware`, fine-tunes through simulated INT8.
 
 #include <nlohmann/json.hpp>
 
 #include "core/run_dir.h"
 #include "distributed/world.h"
+#include "eval/calibration.h"
 #include "models/arch_spec.h"
 #include "pipeline/run_settings.h"
 #include "train/distillation.h"
@@ -25,6 +27,12 @@ struct EnhanceOptions {
   GeometrySpec geometry{true, 16};
 };
 
+// Fine-tuning through simulated INT8 (train/quantization_aware.h), calibrated first.
+struct QuantizationAwareOptions {
+  bool enabled = false;
+  CalibrationOptions calibration;
+};
+
 struct TrainOptions : RunSettings {
   std::string data;          // data set directory (required)
   std::string model = "pan"; // backbone name, spec file, or model file to start from
@@ -33,6 +41,7 @@ struct TrainOptions : RunSettings {
   EnhanceOptions enhance;
   ElasticTrainingOptions elastic;  // train as an elastic network (train/elastic_training.h)
   DistillOptions distill;          // learn a teacher's output too (train/distillation.h)
+  QuantizationAwareOptions quantization_aware;
   TrainSchedule schedule;
   LossOptions loss;
   bool resume = false;       // continue from checkpoint.pt in --out

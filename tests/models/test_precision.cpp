@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "models/fused_graph.h"
 #include "models/precision.h"
+#include "models/subnet.h"
 #include "tests/models/model_cases.h"
 #include "tests/models/numerics_cases.h"
 
@@ -151,6 +152,32 @@ TEST(Precision, WideLayersStayFloat32) {
   EXPECT_THROW(FusedGraph(g, wrong).run(in), Error);
   wrong.low_convs = std::vector<bool>(g.ops.size(), true);
   EXPECT_THROW(FusedGraph(g, wrong).run(in), Error);
+}
+
+// Simulated INT8 (quantization-aware fine-tuning) computes what the fused INT8 path does, far
+// closer to it than float32 is, and passes gradients to the network's weights through the rounding.
+TEST(Precision, SimulatedInt8MatchesTheFusedPathAndPassesGradients) {
+  SRNetwork net = perturbed_network(small_spec("pan", "lr"), 5);
+  net->eval();
+  const graph::Graph g = net->describe();
+  const Inputs calibration_frame = frame_inputs(g, 12, 16, 3), in = frame_inputs(g, 12, 16, 4);
+  const Calibration c = calibrate(g, {calibration_frame}, CalibrationMethod::Max);
+  FusedGraph int8(g, {.precision = Precision::Int8, .calibration = c});
+  const torch::Tensor fused = int8.run(in).front().second;
+  const torch::Tensor fp32 = graph::run(g, in).front().second;
+  const torch::Tensor simulated = run_fake_int8(g, in, c).front().second;
+  const double to_fused = (simulated - fused).abs().max().item<double>();
+  const double fp32_to_fused = (fp32 - fused).abs().max().item<double>();
+  EXPECT_GT(fp32_to_fused, 0);
+  EXPECT_LT(to_fused, 0.25 * fp32_to_fused) << to_fused << " against " << fp32_to_fused;
+  // Through a differentiable graph, a loss of the simulated output reaches the weights.
+  net->train();
+  const graph::Graph d = subnet_graph(*net, full_subnet(net->spec()), /*training=*/false, /*differentiable=*/true);
+  run_fake_int8(d, in, c).front().second.square().mean().backward();
+  double gradient = 0;
+  for (const auto& p : net->parameters())
+    if (p.grad().defined()) gradient += p.grad().abs().sum().item<double>();
+  EXPECT_GT(gradient, 0);
 }
 
 // Every backbone, plain and with a RIT: INT8 and BF16 outputs on frames the calibration did not

@@ -7,11 +7,13 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <unistd.h>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/runtime.h"
 #include "models/arch_spec.h"
+#include "models/model_file.h"
 #include "tests/support/tiny_data.h"
 #include "train/run_identity.h"
 #include "train/trainer.h"
@@ -446,4 +448,39 @@ TEST(RunIdentity, TheDataSetFingerprintTellsDataSetsApart) {
   const auto differences = identity_differences(run_identity(3, schedule, other, spec), now);
   ASSERT_EQ(differences.size(), 1u);
   EXPECT_EQ(differences[0].rfind("data: cgsr 'other', 7 frames", 0), 0u) << differences[0];
+}
+
+// `quantization_aware` fine-tunes through simulated INT8: the same schedule from the same start
+// ends at other weights than the float32 fine-tuning, the calibration it used is in the model
+// file, and an elastic network refuses it.
+TEST(TrainCommand, QuantizationAwareFineTuningTrainsThroughSimulatedInt8) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cgsr_test_qat_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::string common = " --data " + tiny_data().string() +
+                             " --steps 2 --threads 1 --set seed=4 --set schedule.batch_size=2 --set schedule.patch_size=16"
+                             " --set schedule.val_frames=1";
+  auto r = run_cgsr("train --model pan" + common + " --out " + (dir / "start").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string start = (dir / "start" / "model.cgsr").string();
+  r = run_cgsr("train --model " + start + common + " --out " + (dir / "fp32").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cgsr("train --model " + start + common +
+               " --set quantization_aware.enabled=true --set quantization_aware.calibration.frames=2 --out " +
+               (dir / "qat").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("quantization-aware"), std::string::npos) << r.err;
+  const Model fp32 = load_model(dir / "fp32" / "model.cgsr"), qat = load_model(dir / "qat" / "model.cgsr");
+  const auto a = fp32.network->parameters(), b = qat.network->parameters();
+  ASSERT_EQ(a.size(), b.size());
+  bool differ = false;
+  for (size_t i = 0; i < a.size(); ++i) differ = differ || !torch::equal(a[i], b[i]);
+  EXPECT_TRUE(differ);  // the gradients came through the rounding
+  ASSERT_TRUE(qat.provenance.extra.contains("quantization_aware"));
+  EXPECT_EQ(qat.provenance.extra["quantization_aware"]["frames"], 2);
+  EXPECT_FALSE(fp32.provenance.extra.contains("quantization_aware"));
+  r = run_cgsr("train --model " + start + common +
+               " --set elastic.enabled=true --set quantization_aware.enabled=true --out " + (dir / "both").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("quantization_aware"), std::string::npos) << r.err;
+  std::filesystem::remove_all(dir);
 }
