@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -125,31 +126,65 @@ ImageHeader tiff(const Bytes& b) {
   return h;
 }
 
+// The value size OpenEXR reads for each attribute type it knows with a fixed size; it reads
+// that many bytes whatever the header's size field says, so the field must agree.
+int64_t exr_fixed_size(const std::string& type) {
+  static const std::map<std::string, int64_t> sizes = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8}, {"envmap", 1},
+      {"float", 4},  {"int", 4},    {"keycode", 28},        {"lineOrder", 1},   {"m33f", 36},  {"m33d", 72},
+      {"m44f", 64},  {"m44d", 128}, {"rational", 8},        {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+      {"v2f", 8},    {"v2d", 16},   {"v3i", 12},            {"v3f", 12},        {"v3d", 24},   {"deepImageState", 1}};
+  const auto it = sizes.find(type);
+  return it == sizes.end() ? -1 : it->second;
+}
+
 ImageHeader exr(const Bytes& b) {
   // Magic and version, then attributes "name\0type\0<int32 size><value>" up to an empty name.
+  // The header is walked as OpenEXR reads it, so that no attribute it reads can make it allocate
+  // more than the file holds: names of at most 255 bytes, the fixed-size types at their size, a
+  // channel list read to its end, and value sizes within the file (an unknown type is read as
+  // that many bytes). Types whose values allocate by their content (preview images, string
+  // vectors, ID manifests) and deep or multi-part files (more headers) are refused.
+  const uint32_t flags = b.le(4, 4) & ~0xffu;
+  if (flags & ~0x600u) b.fail("an OpenEXR file that is deep or multi-part");
+  const auto name_at = [&](size_t at, const char* what) {
+    const size_t end = b.data().find('\0', at);
+    if (end == std::string::npos) b.fail(kCutShort);
+    if (end - at > 255) b.fail(std::string("an OpenEXR ") + what + " longer than 255 bytes");
+    return b.data().substr(at, end - at);
+  };
   // The whole header is read: OpenEXR takes the last of two dataWindows, so two are refused.
   size_t at = 8;
   std::optional<ImageHeader> found;
   while (true) {
-    const size_t name_end = b.data().find('\0', at);
-    if (name_end == std::string::npos) b.fail(kCutShort);
-    const std::string name = b.data().substr(at, name_end - at);
+    const std::string name = name_at(at, "attribute name");
     if (name.empty()) break;
-    const size_t type_end = b.data().find('\0', name_end + 1);
-    if (type_end == std::string::npos) b.fail(kCutShort);
-    const std::string type = b.data().substr(name_end + 1, type_end - name_end - 1);
-    const uint32_t size = b.le(type_end + 1, 4);
-    const size_t value = type_end + 5;
+    const size_t type_at = at + name.size() + 1;
+    const std::string type = name_at(type_at, "attribute type");
+    const size_t size_at = type_at + type.size() + 1;
+    const int32_t size = static_cast<int32_t>(b.le(size_at, 4));
+    const size_t value = size_at + 4;
+    if (size < 0) b.fail("an OpenEXR attribute of negative size");
+    b.need(value, static_cast<size_t>(size));
+    if (type == "preview" || type == "stringvector" || type == "idmanifest")
+      b.fail("an OpenEXR '" + type + "' attribute (cgsr's frames have none)");
+    const int64_t fixed = exr_fixed_size(type);
+    if (fixed >= 0 && size != fixed)
+      b.fail("an OpenEXR '" + type + "' attribute of " + std::to_string(size) + " bytes, not " + std::to_string(fixed));
+    if (type == "chlist") {  // channels "name\0" + 16 bytes each, up to an empty name
+      size_t c = value;
+      for (std::string channel; !(channel = name_at(c, "channel name")).empty();) c += channel.size() + 1 + 16;
+      if (c + 1 != value + static_cast<size_t>(size)) b.fail("an OpenEXR channel list whose size disagrees with it");
+    }
     if (name == "dataWindow") {
       if (found) b.fail("an OpenEXR header with two dataWindows");
-      if (type != "box2i" || size != 16) b.fail("an OpenEXR dataWindow that is not a box2i");
+      if (type != "box2i") b.fail("an OpenEXR dataWindow that is not a box2i");
       const auto i32 = [&](size_t k) { return static_cast<int64_t>(static_cast<int32_t>(b.le(value + 4 * k, 4))); };
       const int64_t width = i32(2) - i32(0) + 1, height = i32(3) - i32(1) + 1;
       if (width < 1 || height < 1) b.fail("an OpenEXR dataWindow of no pixels");
       found = ImageHeader{"EXR", width, height};
     }
-    b.need(value, size);
-    at = value + size;
+    at = value + static_cast<size_t>(size);
   }
   if (!found) b.fail("an OpenEXR header without a dataWindow");
   return *found;

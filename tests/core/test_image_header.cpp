@@ -113,6 +113,43 @@ TEST(ImageHeader, EveryBombSeedIsRefusedFromItsHeader) {
   }
 }
 
+// An OpenEXR header is walked as OpenEXR reads it. The first 10-minute fuzz_frame_files run found
+// a file (the seed depth_exr_header_walk.bin) whose channel list declared fewer bytes than its
+// channels take: skipping by the size field, the check saw a valid header, while OpenEXR read on
+// from the channels' end into a made-up attribute of 1.85 GB and allocated it. Every attribute's
+// size is now checked against what OpenEXR reads for its type.
+TEST(ImageHeader, AnOpenExrHeaderIsReadAsOpenExrReadsIt) {
+  const std::string found = read_file(fs::path(CGSR_SOURCE_DIR) / "fuzz/corpus/frame_files/depth_exr_header_walk.bin");
+  EXPECT_NE(header_error_of([&] { parse_image_header(found.substr(1), "walk.exr"); }).find("walk.exr: unreadable image: "
+                                                                                         "an OpenEXR"),
+            std::string::npos);
+  // A frame cgsr writes passes; the same with a fixed-size attribute resized, a channel list
+  // that disagrees with its size, an overlong name, a preview or the multi-part flag does not.
+  write_image(header_dir() / "walk.exr", torch::rand({3, 9, 13}), {32});
+  const std::string exr = read_file(header_dir() / "walk.exr");
+  EXPECT_EQ(parse_image_header(exr, "walk.exr").width, 13);
+  const auto refused = [&](std::string bytes, const std::string& why) {
+    const std::string e = header_error_of([&] { parse_image_header(bytes, "walk.exr"); });
+    EXPECT_NE(e.find(why), std::string::npos) << e;
+  };
+  const auto size_of = [&](const std::string& attribute) { return exr.find(attribute) + attribute.size(); };
+  std::string resized = exr;
+  resized[size_of(std::string("compression\0compression\0", 24))] = 2;
+  refused(resized, "'compression' attribute of 2 bytes, not 1");
+  std::string channels = exr;
+  channels[size_of(std::string("channels\0chlist\0", 16))] -= 1;
+  refused(channels, "channel list whose size disagrees");
+  std::string named = exr;
+  named.insert(8, std::string(300, 'n') + std::string("\0int\0\4\0\0\0\0\0\0\0", 13));
+  refused(named, "attribute name longer than 255 bytes");
+  std::string preview = exr;
+  preview.insert(8, std::string("p\0preview\0\0\0\0\0", 14));
+  refused(preview, "'preview' attribute");
+  std::string parts = exr;
+  parts[5] |= 0x10;
+  refused(parts, "deep or multi-part");
+}
+
 // A size given twice in a header is refused: decoders take one or the other (OpenEXR the last
 // dataWindow, libtiff the first width tag), so a small size beside a huge one would pass the
 // check and be decoded huge.
