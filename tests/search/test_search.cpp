@@ -71,6 +71,26 @@ class ScoringEvaluator : public Evaluator {
   int calls_ = 0;
 };
 
+// A latency table measured once per shape, on few subnets: what the tests need is its structure.
+LatencyTableOptions quick_latency_table() {
+  LatencyTableOptions latency;
+  latency.calibration_subnets = 2;
+  latency.check_subnets = 1;
+  latency.runs = 1;
+  latency.subnet_runs = 1;
+  return latency;
+}
+
+// Two 12-pixel crops (2 of margin) of each of two frames.
+ValidationCropOptions small_crops() {
+  ValidationCropOptions crops;
+  crops.frames = 2;
+  crops.crops_per_frame = 2;
+  crops.size = 12;
+  crops.margin = 2;
+  return crops;
+}
+
 SearchOptions small_search(const std::string& strategy = "evolution") {
   SearchOptions o;
   o.strategy.type = strategy;
@@ -242,17 +262,9 @@ TEST(InferenceEvaluator, ScoresSubnetsOfARealNetworkOnRenderedCrops) {
   SRNetwork net(spec);
   net->eval();
   const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
-  LatencyTableOptions latency;
-  latency.calibration_subnets = 2;
-  latency.check_subnets = 1;
-  latency.runs = 1;
-  latency.subnet_runs = 1;
+  const LatencyTableOptions latency = quick_latency_table();
   const LatencyTable table = measure_latency_table(*net, space, 32, 24, latency);
-  ValidationCropOptions crops;
-  crops.frames = 2;
-  crops.crops_per_frame = 2;
-  crops.size = 12;
-  crops.margin = 2;
+  const ValidationCropOptions crops = small_crops();
   InferenceEvaluator evaluator(net, data, crops, {{Precision::Fp32, table}});
   const int frames = std::min<int>(2, static_cast<int>(data.frames(Split::Val).size()));
   EXPECT_EQ(evaluator.crops(), 2 * frames);
@@ -273,11 +285,7 @@ TEST(InferenceEvaluator, ScoresAnInt8SubnetOnTheFusedPathWithItsOwnLatencyTable)
   ElasticOptions options{4, 0.25, 1};
   options.precisions = {Precision::Fp32, Precision::Int8};
   const ElasticSpace space(spec, options);
-  LatencyTableOptions latency;
-  latency.calibration_subnets = 2;
-  latency.check_subnets = 1;
-  latency.runs = 1;
-  latency.subnet_runs = 1;
+  const LatencyTableOptions latency = quick_latency_table();
   std::map<Precision, LatencyTable> tables;
   for (Precision p : options.precisions) tables[p] = measure_latency_table(*net, space, 32, 24, latency, p);
   // The int8 table times the inner convolutions in int8 and the wide first and last in float32.
@@ -296,11 +304,7 @@ TEST(InferenceEvaluator, ScoresAnInt8SubnetOnTheFusedPathWithItsOwnLatencyTable)
   EXPECT_EQ(back.at(Precision::Int8).conv_ms, tables.at(Precision::Int8).conv_ms);
   extra["latency_table_bf16"] = extra["latency_table_int8"];
   EXPECT_THROW(latency_tables_from(extra, "model.cgsr"), Error);
-  ValidationCropOptions crops;
-  crops.frames = 2;
-  crops.crops_per_frame = 2;
-  crops.size = 12;
-  crops.margin = 2;
+  const ValidationCropOptions crops = small_crops();
   InferenceEvaluator evaluator(net, data, crops, tables);
   SubnetConfig int8 = space.smallest();
   int8.precision = Precision::Int8;
