@@ -113,6 +113,11 @@ SubnetConfig ElasticSpace::sample(std::mt19937_64& rng, ShrinkLimits limits) con
   std::shuffle(all.begin(), all.end(), rng);
   sub.blocks.assign(all.begin(), all.begin() + blocks);
   std::sort(sub.blocks.begin(), sub.blocks.end());
+  return sub;
+}
+
+SubnetConfig ElasticSpace::sample_candidate(std::mt19937_64& rng) const {
+  SubnetConfig sub = sample(rng);
   if (options_.precisions.size() > 1) {
     std::uniform_int_distribution<size_t> pick(0, options_.precisions.size() - 1);
     sub.precision = options_.precisions[pick(rng)];

@@ -73,10 +73,12 @@ class ElasticSpace {
   SubnetConfig full() const;
   // Every gene at its lowest choice within `limits`, the most important blocks kept.
   SubnetConfig smallest(ShrinkLimits limits = {}) const;
-  // Widths drawn uniformly among the allowed ones within `limits`, a block count uniformly,
-  // which blocks uniformly among the subsets of that size, and a precision uniformly (when the
-  // options list more than one).
+  // Widths drawn uniformly among the allowed ones within `limits`, a block count uniformly, and
+  // which blocks uniformly among the subsets of that size; float32 (training and the latency
+  // table draw the same subnets whatever the precisions).
   SubnetConfig sample(std::mt19937_64& rng, ShrinkLimits limits = {}) const;
+  // A search candidate: sample(), then a precision drawn uniformly among the listed ones.
+  SubnetConfig sample_candidate(std::mt19937_64& rng) const;
   // Whether the subnet is one of the space's (allowed widths, enough blocks).
   bool contains(const SubnetConfig& sub) const;
   // Every width rounded to the nearest allowed one, the block count raised to the minimum

@@ -35,7 +35,7 @@ class Evolution : public SearchStrategy {
   std::vector<SubnetConfig> propose(const std::vector<Candidate>& population, int count,
                                     const std::function<bool(const std::string&)>& seen,
                                     std::mt19937_64& rng) override {
-    if (population.empty()) return collect_unseen(count, seen, [&] { return space_.sample(rng); });
+    if (population.empty()) return collect_unseen(count, seen, [&] { return space_.sample_candidate(rng); });
     std::uniform_real_distribution<double> u(0, 1);
     std::uniform_int_distribution<size_t> pick(0, population.size() - 1);
     // Binary tournament: the population is sorted best first, so the lower index wins.
@@ -58,7 +58,7 @@ class RandomSearch : public SearchStrategy {
   std::vector<SubnetConfig> propose(const std::vector<Candidate>&, int count,
                                     const std::function<bool(const std::string&)>& seen,
                                     std::mt19937_64& rng) override {
-    return collect_unseen(count, seen, [&] { return space_.sample(rng); });
+    return collect_unseen(count, seen, [&] { return space_.sample_candidate(rng); });
   }
 
  private:

@@ -209,11 +209,15 @@ TEST(ElasticSpace, PrecisionIsAGeneWhenTheOptionsListSeveral) {
   std::mt19937_64 rng(2);
   std::set<Precision> drawn;
   for (int i = 0; i < 40; ++i) {
-    const auto sub = space.sample(rng);
+    const auto sub = space.sample_candidate(rng);
     EXPECT_TRUE(space.contains(sub)) << subnet_key(sub);
     drawn.insert(sub.precision);
   }
   EXPECT_EQ(drawn.size(), 2u);
+  // Training draws the same subnets as without the option: structure only, in float32.
+  const ElasticSpace plain(small_pan(), ElasticOptions{4, 0.5, 2});
+  std::mt19937_64 a(3), b(3);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(space.sample(a), plain.sample(b));
   // A precision the space does not list is outside it; repair gives the first listed.
   SubnetConfig bf16 = space.full();
   bf16.precision = Precision::Bf16;
