@@ -26,6 +26,8 @@ config::Schema<ElasticOptions> elastic_options_schema() {
   s.field("fixed_groups", &ElasticOptions::fixed_groups, "layer groups that always keep every channel");
   s.field("precisions", &ElasticOptions::precisions,
           "formats a subnet may run in (fp32, bf16, int8): a latency table for each, the search picks one");
+  // Configs written before the option hash as they did, so their cached stages stay valid.
+  s.omit_when("precisions", [](const ElasticOptions& o) { return o.precisions == std::vector{Precision::Fp32}; });
   s.validate([](const ElasticOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (o.precisions.empty() || o.precisions.front() != Precision::Fp32)
       at.child("precisions").fail(node["precisions"], "must start with fp32 (the full network's format)");
