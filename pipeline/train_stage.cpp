@@ -171,9 +171,8 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
     extra["teacher"] = options.distill.teacher;
   }
   if (options.quantization_aware.enabled) {
-    network->eval();
     const Calibration calibration = calibrate_network(*network, data, options.quantization_aware.calibration);
-    network->train();
+    network->train();  // calibrate_network left it in eval mode
     hooks = quantization_aware(hooks, network, calibration);
     extra["quantization_aware"] = calibration_json(calibration);
     spdlog::info("{}: quantization-aware: training and validating through simulated int8", name);

@@ -101,9 +101,10 @@ nlohmann::ordered_json prune(const std::filesystem::path& elastic_path, const st
                              bool resume, const nlohmann::ordered_json& config) {
   Model elastic = load_model(elastic_path);
   elastic.network->eval();
-  if (!elastic.provenance.extra.contains("latency_table"))
+  const auto tables = latency_tables_from(elastic.provenance.extra, elastic_path.string());
+  if (!tables.count(Precision::Fp32))
     throw Error(elastic_path.string(), "has no latency table (train it with elastic.enabled)");
-  const LatencyTable table = latency_table_from_json(elastic.provenance.extra.at("latency_table"), elastic_path.string());
+  const LatencyTable& table = tables.at(Precision::Fp32);
   SearchOutcome search = read_search(search_path);
   // The hybrid runs in float32: the search's subnets in other precisions are priced as float32
   // (same structure, quality within the search's quantization loss) and the front taken again.
