@@ -166,6 +166,11 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
     problems.push_back({"geometry.width", config::out_of_range(spec.geometry.width, 1, config::kUnbounded)});
+  const std::string no_hr = spec.backbone + " has no HR feature map (its last layer upsamples to the image)";
+  if (!info.has_hr_features && spec.rit.enabled && spec.rit.hr_branch())
+    problems.push_back({"rit.source", no_hr + ", so the RIT cannot join at HR: use lr, hr_pooled or hr_unshuffle"});
+  if (!info.has_hr_features && spec.geometry.enabled)
+    problems.push_back({"geometry.enabled", no_hr + " for the geometry head to read"});
   return problems;
 }
 

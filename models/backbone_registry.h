@@ -34,6 +34,12 @@ struct BackboneInfo {
   int max_blocks = 0;
   bool supports_y = false;  // may run on BT.601 luma (colors: y)
   bool has_image_skip = false;  // adds the interpolated LR image to its output (image_skip)
+  // Has features at the output resolution before its last convolution: where the RIT's HR branch
+  // (rit.source hr_fuse) and the geometry head read. A backbone whose last layer upsamples has none.
+  bool has_hr_features = true;
+  // The blocks no subnet may skip, given the block count (e.g. one whose inner value a later
+  // layer reads); none when unset.
+  std::function<std::vector<int>(int blocks)> fixed_blocks;
   // Per-block groups are named "block<i>_<suffix>"; the suffixes, for error messages.
   std::vector<std::string> block_group_suffixes;
   // Every layer group of a network with this scale and block count, in canonical order.

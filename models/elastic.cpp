@@ -60,6 +60,9 @@ ElasticSpace::ElasticSpace(const ArchSpec& spec, ElasticOptions options, std::ve
   if (sorted != expected)
     throw Error("elastic space", "the block order must list each of the network's " + std::to_string(spec_.blocks) +
                                      " blocks once");
+  // Blocks no subnet may skip lead the order, so the smallest subnet keeps them too.
+  if (const auto& fixed = backbone_registry().get(spec_.backbone).fixed_blocks) fixed_blocks_ = fixed(spec_.blocks);
+  std::stable_partition(block_order_.begin(), block_order_.end(), [&](int b) { return is_fixed_block(b); });
   if (options_.precisions.empty()) throw Error("elastic space: precisions", "lists no precision");
   const auto groups = layer_groups(spec_);
   for (const auto& g : options_.fixed_groups)
@@ -82,7 +85,11 @@ ElasticSpace::ElasticSpace(const ArchSpec& spec, ElasticOptions options, std::ve
 
 int ElasticSpace::min_blocks() const {
   if (!options_.elastic_depth) return spec_.blocks;
-  return std::min(spec_.blocks, options_.min_blocks);
+  return std::max(static_cast<int>(fixed_blocks_.size()), std::min(spec_.blocks, options_.min_blocks));
+}
+
+bool ElasticSpace::is_fixed_block(int block) const {
+  return std::find(fixed_blocks_.begin(), fixed_blocks_.end(), block) != fixed_blocks_.end();
 }
 
 SubnetConfig ElasticSpace::full() const { return full_subnet(spec_); }
@@ -110,10 +117,12 @@ SubnetConfig ElasticSpace::sample(std::mt19937_64& rng, ShrinkLimits limits) con
   const int total = spec_.blocks;
   std::uniform_int_distribution<int> count(lowest_block_count(limits.depth), total);
   const int blocks = count(rng);
-  std::vector<int> all(total);
-  std::iota(all.begin(), all.end(), 0);
-  std::shuffle(all.begin(), all.end(), rng);
-  sub.blocks.assign(all.begin(), all.begin() + blocks);
+  std::vector<int> skippable;
+  for (int b = 0; b < total; ++b)
+    if (!is_fixed_block(b)) skippable.push_back(b);
+  std::shuffle(skippable.begin(), skippable.end(), rng);
+  sub.blocks = fixed_blocks_;
+  sub.blocks.insert(sub.blocks.end(), skippable.begin(), skippable.begin() + (blocks - static_cast<int>(fixed_blocks_.size())));
   std::sort(sub.blocks.begin(), sub.blocks.end());
   return sub;
 }
@@ -130,6 +139,8 @@ SubnetConfig ElasticSpace::sample_candidate(std::mt19937_64& rng) const {
 bool ElasticSpace::contains(const SubnetConfig& sub) const {
   if (!subnet_problems(spec_, sub).empty()) return false;
   if (static_cast<int>(sub.blocks.size()) < min_blocks()) return false;
+  for (int b : fixed_blocks_)
+    if (std::find(sub.blocks.begin(), sub.blocks.end(), b) == sub.blocks.end()) return false;
   if (std::find(options_.precisions.begin(), options_.precisions.end(), sub.precision) == options_.precisions.end())
     return false;
   for (const auto& g : genes_) {
@@ -147,7 +158,7 @@ SubnetConfig ElasticSpace::repair(SubnetConfig sub) const {
       if (std::abs(c - w) < std::abs(best - w) || (std::abs(c - w) == std::abs(best - w) && c > best)) best = c;
     sub.widths[g.group] = best;
   }
-  std::vector<int> blocks;
+  std::vector<int> blocks = fixed_blocks_;
   for (int b : sub.blocks)
     if (b >= 0 && b < spec_.blocks && std::find(blocks.begin(), blocks.end(), b) == blocks.end()) blocks.push_back(b);
   for (int b : block_order_) {

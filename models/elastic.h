@@ -7,7 +7,7 @@
 // importance once (L1 magnitude of the weights producing them, the order Once-for-All uses), so
 // the first channels matter most; widths are multiples of a quantum between a minimum fraction of
 // the full width and the full width. Every residual block has an elastic depth: it can be
-// skipped. The space knows the choices; train/elastic_training.h trains them (sandwich rule,
+// skipped (but for the backbone's fixed blocks, BackboneInfo::fixed_blocks). The space knows the choices; train/elastic_training.h trains them (sandwich rule,
 // in-place distillation), search/ picks among them.
 //
 //   ElasticSpace space(net->spec(), options, block_order);
@@ -88,9 +88,11 @@ class ElasticSpace {
 
  private:
   int lowest_block_count(double depth_limit) const;
+  bool is_fixed_block(int block) const;
   ArchSpec spec_;
   ElasticOptions options_;
   std::vector<int> block_order_;
+  std::vector<int> fixed_blocks_;  // blocks every subnet keeps (BackboneInfo::fixed_blocks)
   std::vector<Gene> genes_;
 };
 

@@ -54,10 +54,24 @@ void check_block_map(const ArchSpec& parent, const ArchSpec& child, const std::v
                "inherit: the parent blocks of a child must be ascending parent block indices");
 }
 
+// The parent blocks a shallower child inherits when the caller names none: the first ones, and
+// the backbone's fixed blocks (BackboneInfo::fixed_blocks) always. Empty: block i from block i.
+std::vector<int> default_parent_blocks(const ArchSpec& parent, const ArchSpec& child) {
+  const auto& fixed_blocks = backbone_registry().get(parent.backbone).fixed_blocks;
+  if (!fixed_blocks || child.blocks >= parent.blocks || child.blocks <= 0) return {};
+  std::vector<int> blocks = fixed_blocks(parent.blocks);
+  for (int b = 0; b < parent.blocks && static_cast<int>(blocks.size()) < child.blocks; ++b)
+    if (std::find(blocks.begin(), blocks.end(), b) == blocks.end()) blocks.push_back(b);
+  std::sort(blocks.begin(), blocks.end());
+  if (static_cast<int>(blocks.size()) != child.blocks) return {};  // too shallow to keep them: a clear error later
+  return blocks;
+}
+
 }  // namespace
 
 std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child,
-                                              const std::vector<int>& parent_blocks) {
+                                              const std::vector<int>& given_blocks) {
+  const auto parent_blocks = given_blocks.empty() ? default_parent_blocks(parent, child) : given_blocks;
   std::vector<std::string> p;
   if (child.backbone != parent.backbone)
     p.push_back("backbone " + child.backbone + " differs from the parent's " + parent.backbone);
@@ -111,12 +125,14 @@ std::vector<int64_t> axis_indices(const graph::Layout& parent, const graph::Layo
                                   const std::map<std::string, std::vector<int64_t>>& kept, const BlockMap& map,
                                   const std::string& what) {
   std::vector<int64_t> out;
+  std::map<std::string, int> seen;  // a group concatenated twice (SPAN's conv_cat): the n-th to the n-th
   for (const auto& cs : child) {
     const std::string group = map.group(cs.group);
     int64_t offset = 0;
     const graph::Segment* ps = nullptr;
+    int skip = seen[group]++;
     for (const auto& s : parent) {
-      if (s.group == group) {
+      if (s.group == group && skip-- == 0) {
         ps = &s;
         break;
       }
@@ -194,8 +210,9 @@ bool fresh_allowed(const std::string& name) { return name.rfind("rit.", 0) == 0 
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec) { return inherit(parent, child_spec, {}); }
 
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec_in,
-                    const std::map<std::string, std::vector<int64_t>>& kept, const std::vector<int>& parent_blocks) {
+                    const std::map<std::string, std::vector<int64_t>>& kept, const std::vector<int>& given_blocks) {
   const ArchSpec child_spec = resolve_spec(child_spec_in);
+  const auto parent_blocks = given_blocks.empty() ? default_parent_blocks(parent.spec(), child_spec) : given_blocks;
   const auto problems = inheritance_problems(parent.spec(), child_spec, parent_blocks);
   if (!problems.empty())
     throw Error("inherit " + spec_summary(child_spec) + " from " + spec_summary(parent.spec()), join(problems, "; "));

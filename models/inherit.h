@@ -39,13 +39,14 @@ Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec);
 // distinct parent channel indices in the child's channel order, as many as the child's width of
 // that group (a permutation of a same-width group reorders its channels). Groups not listed are
 // chosen by importance as above. `parent_blocks` (ascending, one per child block) names the
-// parent block each child block inherits; empty: the first child.blocks blocks.
+// parent block each child block inherits; empty: the first child.blocks blocks, but for the
+// backbone's fixed blocks, which are always among them (SPAN's first and last).
 Inheritance inherit(const SRNetworkImpl& parent, const ArchSpec& child_spec,
                     const std::map<std::string, std::vector<int64_t>>& kept,
                     const std::vector<int>& parent_blocks = {});
 
 // The child spec's problems with `parent` (empty when inheritance is possible), with child block
-// i compared to parent block parent_blocks[i] (empty: block i).
+// i compared to parent block parent_blocks[i] (empty: as inherit chooses them).
 std::vector<std::string> inheritance_problems(const ArchSpec& parent, const ArchSpec& child,
                                               const std::vector<int>& parent_blocks = {});
 

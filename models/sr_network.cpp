@@ -8,6 +8,7 @@
 #include "core/tensor_checks.h"
 #include "core/text.h"
 #include "models/backbone_registry.h"
+#include "models/reparameterization.h"
 
 namespace cgsr {
 
@@ -18,7 +19,9 @@ SRNetworkImpl::SRNetworkImpl(const ArchSpec& spec) : spec_(resolve_spec(spec)) {
     rit_ = register_module(
         "rit", RitBlock(spec_.rit, spec_.scale,
                         FusionPoint{b.feature_group(), spec_.group_width(b.feature_group()), b.feature_factor()},
-                        FusionPoint{b.hr_fusion_group(), spec_.group_width(b.hr_fusion_group()), spec_.scale}));
+                        spec_.rit.hr_branch() ? FusionPoint{b.hr_fusion_group(), spec_.group_width(b.hr_fusion_group()),
+                                                            spec_.scale}
+                                              : FusionPoint{}));
   }
   if (spec_.geometry.enabled)
     geometry_ = register_module("geometry", GeometryHead(spec_.group_width(backbone_->hr_feature_group()),
@@ -91,6 +94,12 @@ torch::Tensor SRNetworkImpl::geometry_target(const Batch& batch) const {
 }
 
 graph::Graph SRNetworkImpl::describe(bool training) const {
+  return training ? describe_graph(true) : fold_branch_convs(describe_graph(false));
+}
+
+graph::Graph SRNetworkImpl::describe_branches() const { return describe_graph(false); }
+
+graph::Graph SRNetworkImpl::describe_graph(bool training) const {
   graph::Builder g;
   const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
   const int info = has_rit() ? g.input(rit_->input_name(), info_layout(input_channels()), rit_->info_factor()) : -1;
@@ -145,8 +154,8 @@ int64_t total_parameter_count(const SRNetworkImpl& net) {
 
 int64_t inference_parameter_count(const SRNetworkImpl& net) {
   int64_t n = 0;
-  for (const auto& p : net.named_parameters(/*recurse=*/true))
-    if (p.key().rfind("geometry.", 0) != 0) n += p.value().numel();
+  for (const auto& op : net.describe(false).ops)
+    if (op.trainable) n += graph::tensor_elements(op);
   return n;
 }
 

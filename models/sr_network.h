@@ -49,9 +49,13 @@ class SRNetworkImpl : public torch::nn::Module {
   torch::Tensor geometry_target(const Batch& batch) const;
 
   // The inference graph (graph.h): inputs "color" (+ the RIT's "info" or "info_hr"), output
-  // "image". With
-  // `training`, also the geometry head and its output "geometry".
+  // "image", re-parameterizable branches folded (reparameterization.h): the deployed network.
+  // With `training`, the graph training differentiates: branches kept, and the geometry head
+  // and its output "geometry".
   graph::Graph describe(bool training = false) const;
+  // The inference graph before its branches are folded: what a subnet is cut from (subnet.h),
+  // since narrowing a branch's inner channels does not commute with folding.
+  graph::Graph describe_branches() const;
 
   // The RIT gate R [C] (a parameter; undefined without RIT).
   torch::Tensor rit_gate() const;
@@ -67,6 +71,7 @@ class SRNetworkImpl : public torch::nn::Module {
  private:
   void check_inputs(const torch::Tensor& lr_color, const torch::Tensor& info) const;
   void check_depth_encoding(const Batch& batch) const;
+  graph::Graph describe_graph(bool training) const;
   Reconstruction run(const torch::Tensor& lr_color, const torch::Tensor& info);
   ArchSpec spec_;
   std::shared_ptr<BackboneImpl> backbone_;
@@ -81,7 +86,8 @@ std::vector<std::pair<std::string, torch::Tensor>> network_inputs(const graph::G
                                                                   const torch::Tensor& lr_color,
                                                                   const torch::Tensor& info);
 
-// Trainable parameters: all of them, and those of the inference network (no geometry head).
+// Trainable parameters: all of them, and those of the inference network (its graph: no geometry
+// head, re-parameterizable branches folded).
 int64_t total_parameter_count(const SRNetworkImpl& net);
 int64_t inference_parameter_count(const SRNetworkImpl& net);
 

@@ -10,6 +10,7 @@
 #include "core/text.h"
 #include "models/backbone_registry.h"
 #include "models/inherit.h"
+#include "models/reparameterization.h"
 
 namespace cgsr {
 
@@ -101,6 +102,10 @@ std::vector<std::string> subnet_problems(const ArchSpec& spec, const SubnetConfi
     else if (i > 0 && b <= sub.blocks[i - 1]) p.push_back("blocks must be ascending and distinct");
   }
   if (spec.blocks > 0 && sub.blocks.empty()) p.push_back("keeps no block");
+  if (const auto& fixed = backbone_registry().get(spec.backbone).fixed_blocks)
+    for (int b : fixed(spec.blocks))
+      if (!std::binary_search(sub.blocks.begin(), sub.blocks.end(), b))
+        p.push_back("skips block " + std::to_string(b) + ", which every " + spec.backbone + " subnet keeps");
   const auto groups = layer_groups(spec);
   for (const auto& [group, width] : sub.widths) {
     // Named in the capture: C++17 lambdas cannot capture a structured binding (clang refuses).
@@ -194,8 +199,10 @@ ChannelSelection subnet_selection(const graph::Graph& graph, const SubnetConfig&
 graph::Graph subnet_graph(const SRNetworkImpl& net, const SubnetConfig& sub, bool training, bool differentiable) {
   const auto problems = subnet_problems(net.spec(), sub);
   if (!problems.empty()) throw Error("subnet " + subnet_key(sub), join(problems, "; "));
-  const graph::Graph full = skip_blocks(net.describe(training), sub.blocks, net.spec().blocks);
-  return select_channels(full, subnet_selection(full, sub), differentiable);
+  const graph::Graph full =
+      skip_blocks(training ? net.describe(true) : net.describe_branches(), sub.blocks, net.spec().blocks);
+  graph::Graph narrowed = select_channels(full, subnet_selection(full, sub), differentiable);
+  return training ? narrowed : fold_branch_convs(narrowed);
 }
 
 ArchSpec subnet_spec(const ArchSpec& full, const SubnetConfig& sub) {

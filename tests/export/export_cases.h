@@ -67,6 +67,7 @@ inline std::vector<ExportCase> export_cases() {
                    with_rit(default_spec("edsr", 2), "hr_unshuffle+hr_fuse", "add")});
   cases.push_back({"srcnn_x3_rit_hr_fuse_concat", with_rit(default_spec("srcnn", 3), "hr_fuse", "concat")});
   cases.push_back({"shrunk_edsr_x4", shrunk_edsr(4)});
+  cases.push_back({"span_x2_rit_hr_unshuffle_concat", with_rit(default_spec("span", 2), "hr_unshuffle", "concat")});
   ArchSpec bicubic_skip = default_spec("pan", 3);
   bicubic_skip.image_skip = ImageSkip::Bicubic;
   cases.push_back({"pan_x3_bicubic_skip", bicubic_skip});

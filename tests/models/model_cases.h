@@ -42,6 +42,16 @@ inline std::string case_name(const BackboneCase& c) {
   return c.backbone + " x" + std::to_string(c.scale) + (c.colors == "y" ? " (Y)" : "");
 }
 
+// Whether the backbone has HR features for the RIT's HR branch and the geometry head (SPAN has not).
+inline bool has_hr_features(const std::string& backbone) { return backbone_registry().get(backbone).has_hr_features; }
+// The RIT sources the backbone takes.
+inline std::vector<std::string> rit_sources_for(const std::string& backbone) {
+  std::vector<std::string> sources;
+  for (const auto& source : rit_sources())
+    if (has_hr_features(backbone) || source.find("hr_fuse") == std::string::npos) sources.push_back(source);
+  return sources;
+}
+
 // A spec with a RIT reading every channel the paper uses.
 inline ArchSpec with_rit(ArchSpec s, const std::string& source = "lr", const std::string& fusion = "concat",
                          bool geometry = false) {

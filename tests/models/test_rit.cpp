@@ -15,10 +15,10 @@ TEST(Rit, EnhancedNetworkEqualsItsBackboneAtInitialization) {
   torch::manual_seed(3);
   for (const auto& c : all_backbone_cases()) {
     SRNetwork backbone(spec_for(c));
-    for (const auto& source : rit_sources())
+    for (const auto& source : cgsr::test::rit_sources_for(c.backbone))
       for (const char* fusion : {"concat", "add"}) {
         SCOPED_TRACE(case_name(c) + " " + source + " " + fusion);
-        const ArchSpec cg = with_rit(spec_for(c), source, fusion, /*geometry=*/true);
+        const ArchSpec cg = with_rit(spec_for(c), source, fusion, cgsr::test::has_hr_features(c.backbone));
         auto child = inherit(*backbone, cg);
         EXPECT_FALSE(child.fresh.empty());
         const auto [color, info] = random_inputs(cg, 6, 5);

@@ -23,6 +23,16 @@ ArchSpec small_pan(int scale = 2) {
   return test::with_rit(resolve_spec(s), "hr_unshuffle+hr_fuse");
 }
 
+// SPAN x2 with 3 blocks (the last one fixed) and a RIT on the LR grid.
+ArchSpec small_span() {
+  ArchSpec s = default_spec("span", 2);
+  s.blocks = 3;
+  s.widths = {};
+  s = resolve_spec(s);
+  for (const auto& [group, width] : s.widths.entries()) s.widths.set(group, 16);
+  return test::with_rit(resolve_spec(s), "hr_unshuffle");
+}
+
 ArchSpec small_edsr() {
   ArchSpec s = default_spec("edsr", 2);
   s.blocks = 3;
@@ -40,23 +50,27 @@ torch::Tensor run_image(const graph::Graph& g, const torch::Tensor& color, const
   return graph::run(g, network_inputs(g, color, info), nullptr, observer).front().second;
 }
 
-// The full graph with the subnet's dropped channels zeroed after every op and the skipped blocks'
-// branches zeroed: what the subnet must compute.
+// The full graph (branches unfolded) with the subnet's dropped channels zeroed after every op,
+// and a skipped block's output replaced by its input: what the subnet must compute.
 torch::Tensor masked_full(const SRNetworkImpl& net, const SubnetConfig& sub, const torch::Tensor& color,
                           const torch::Tensor& info) {
-  const graph::Graph g = net.describe(false);
+  const graph::Graph g = net.describe_branches();
   std::vector<int> block_of(g.ops.size(), -1);
-  std::map<int, size_t> last_op;  // block -> its last op (the residual sum)
+  std::map<int, size_t> last_op;  // block -> its last op (its output)
+  std::map<int, int> block_input;  // block -> the value it reads from before it
   for (size_t i = 0; i < g.ops.size(); ++i) {
     const std::string prefix = "backbone.blocks.";
     if (g.ops[i].name.rfind(prefix, 0) != 0) continue;
     block_of[i] = std::stoi(g.ops[i].name.substr(prefix.size()));
     last_op[block_of[i]] = i;
+    if (!block_input.count(block_of[i])) block_input[block_of[i]] = g.ops[i].inputs[0];
   }
+  std::map<int, torch::Tensor> seen;  // value -> what later ops read
+  for (const auto& [name, v] : g.inputs) seen[v] = name == "color" ? color : info;
   const auto observer = [&](size_t op, const torch::Tensor& out) -> torch::Tensor {
     const int b = block_of[op];
     const bool skipped = b >= 0 && !std::binary_search(sub.blocks.begin(), sub.blocks.end(), b);
-    if (skipped && last_op[b] != op) return torch::zeros_like(out);
+    if (skipped) return seen[g.ops[op].output] = last_op[b] == op ? seen.at(block_input[b]) : torch::zeros_like(out);
     auto masked = out.clone();
     int64_t offset = 0;
     for (const auto& s : g.values[g.ops[op].output].layout) {
@@ -66,13 +80,13 @@ torch::Tensor masked_full(const SRNetworkImpl& net, const SubnetConfig& sub, con
       }
       offset += s.channels * s.repeat;
     }
-    return masked;
+    return seen[g.ops[op].output] = masked;
   };
   return run_image(g, color, info, observer);
 }
 
 TEST(Subnet, EqualsTheFullNetworkWithDroppedChannelsAndBlocksMasked) {
-  for (const ArchSpec& spec : {small_pan(2), small_pan(4), small_edsr()}) {
+  for (const ArchSpec& spec : {small_pan(2), small_pan(4), small_edsr(), small_span()}) {
     SCOPED_TRACE(spec_summary(spec));
     const SRNetwork net = test::build_network(spec, 3);
     const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
@@ -83,7 +97,8 @@ TEST(Subnet, EqualsTheFullNetworkWithDroppedChannelsAndBlocksMasked) {
       SCOPED_TRACE(subnet_key(sub));
       const auto narrow = run_image(subnet_graph(*net, sub), color, info);
       const auto masked = masked_full(*net, sub, color, info);
-      EXPECT_LT((narrow - masked).abs().max().item<double>(), 1e-5);
+      // Relative to the output's size: SPAN scales its input by 255 and a random one keeps that.
+      EXPECT_LT((narrow - masked).abs().max().item<double>(), 1e-5 * std::max(1.0, masked.abs().max().item<double>()));
     }
   }
 }
@@ -124,21 +139,47 @@ TEST(Subnet, LeadingChannelsAreViewsOfTheNetworksWeights) {
 }
 
 TEST(Subnet, MaterializedSubnetComputesTheSameAsItsGraph) {
-  const ArchSpec spec = small_pan();
-  const SRNetwork net = test::build_network(spec, 4);
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
-  std::mt19937_64 rng(11);
-  const auto [color, info] = test::random_inputs(spec, 10, 6);
-  for (int i = 0; i < 4; ++i) {
-    const SubnetConfig sub = space.sample(rng);
-    SRNetwork small = materialize_subnet(*net, sub);
-    EXPECT_EQ(small->spec().blocks, static_cast<int>(sub.blocks.size()));
-    small->eval();
-    torch::NoGradGuard no_grad;
-    const auto a = small->forward(color, info);
-    const auto b = run_image(subnet_graph(*net, sub), color, info);
-    EXPECT_LT((a - b).abs().max().item<double>(), 1e-5) << subnet_key(sub);
+  for (const ArchSpec& spec : {small_pan(), small_span()}) {
+    SCOPED_TRACE(spec_summary(spec));
+    const SRNetwork net = test::build_network(spec, 4);
+    const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+    std::mt19937_64 rng(11);
+    const auto [color, info] = test::random_inputs(spec, 10, 6);
+    for (int i = 0; i < 4; ++i) {
+      const SubnetConfig sub = space.sample(rng);
+      SRNetwork small = materialize_subnet(*net, sub);
+      EXPECT_EQ(small->spec().blocks, static_cast<int>(sub.blocks.size()));
+      small->eval();
+      torch::NoGradGuard no_grad;
+      const auto a = small->forward(color, info);
+      const auto b = run_image(subnet_graph(*net, sub), color, info);
+      EXPECT_LT((a - b).abs().max().item<double>(), 1e-5 * std::max(1.0, b.abs().max().item<double>()))
+          << subnet_key(sub);
+    }
   }
+}
+
+TEST(ElasticSpace, EverySubnetKeepsTheBackbonesFixedBlocks) {
+  const ArchSpec spec = small_span();  // conv_cat reads SPAN's first block and inside its last
+  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+  EXPECT_EQ(space.min_blocks(), 2);
+  EXPECT_EQ(space.smallest().blocks, (std::vector<int>{0, 2}));
+  std::mt19937_64 rng(5);
+  int skipped = 0;
+  for (int i = 0; i < 20; ++i) {
+    const SubnetConfig sub = space.sample(rng);
+    EXPECT_TRUE(std::binary_search(sub.blocks.begin(), sub.blocks.end(), 0)) << subnet_key(sub);
+    EXPECT_TRUE(std::binary_search(sub.blocks.begin(), sub.blocks.end(), 2)) << subnet_key(sub);
+    EXPECT_TRUE(space.contains(sub));
+    skipped += sub.blocks.size() == 2;
+  }
+  EXPECT_GT(skipped, 0);
+  SubnetConfig without_last = space.full();
+  without_last.blocks = {0, 1};
+  EXPECT_FALSE(space.contains(without_last));
+  EXPECT_EQ(space.repair(without_last).blocks, (std::vector<int>{0, 1, 2}));
+  const SRNetwork net = test::build_network(spec, 1);
+  EXPECT_THROW(subnet_graph(*net, without_last), Error);
 }
 
 TEST(Subnet, DifferentiableGraphTrainsTheKeptWeightsOnly) {
