@@ -319,6 +319,30 @@ torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, c
   return y;
 }
 
+Graph rewrite(const Graph& graph, const std::vector<std::optional<Op>>& ops, const std::vector<int>& alias) {
+  CGSR_CHECK(ops.size() == graph.ops.size(), "graph rewrite: one entry per op");
+  std::vector<int> index(graph.values.size(), -1);
+  Graph out;
+  const auto keep_value = [&](int v) {
+    if (!alias.empty()) v = alias.at(v);
+    if (index[v] < 0) {
+      index[v] = static_cast<int>(out.values.size());
+      out.values.push_back(graph.values[v]);
+    }
+    return index[v];
+  };
+  for (const auto& [name, v] : graph.inputs) out.inputs.emplace_back(name, keep_value(v));
+  for (const auto& op : ops) {
+    if (!op) continue;
+    Op kept = *op;
+    for (int& v : kept.inputs) v = keep_value(v);
+    kept.output = keep_value(kept.output);
+    out.ops.push_back(std::move(kept));
+  }
+  for (const auto& [name, v] : graph.outputs) out.outputs.emplace_back(name, keep_value(v));
+  return out;
+}
+
 // ---- interpreter -------------------------------------------------------------------------------
 
 std::vector<std::pair<std::string, torch::Tensor>> run(

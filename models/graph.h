@@ -48,6 +48,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -188,6 +189,11 @@ class Builder {
   Graph graph_;
   std::string prefix_;
 };
+
+// A graph rewritten: `ops[i]` replaces op i (nullopt drops it; it keeps the original value
+// indices), and every value index v that ops and outputs refer to reads `alias[v]` instead
+// (empty: no aliases). The values left are renumbered in order of first use.
+Graph rewrite(const Graph& graph, const std::vector<std::optional<Op>>& ops, const std::vector<int>& alias = {});
 
 // The kernels modules and the interpreter share, so both compute identical bits.
 torch::Tensor apply_resize(const torch::Tensor& x, int64_t factor, ResizeMode mode);

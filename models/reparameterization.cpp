@@ -2,7 +2,6 @@
 
 #include <torch/torch.h>
 
-#include <algorithm>
 #include <optional>
 
 #include "core/error.h"
@@ -83,8 +82,8 @@ graph::Graph fold_branch_convs(const graph::Graph& graph) {
     return Branches{*expand, *spatial, *squeeze, *skip};
   };
 
-  std::vector<bool> drop(ops.size(), false);
-  std::vector<std::optional<graph::Op>> replacement(ops.size());
+  std::vector<std::optional<graph::Op>> rewritten(ops.begin(), ops.end());
+  bool folded_any = false;
   for (size_t i = 0; i < ops.size(); ++i) {
     if (ops[i].kind != graph::OpKind::Add) continue;
     auto b = match(ops[i].inputs[0], ops[i].inputs[1]);
@@ -102,31 +101,11 @@ graph::Graph fold_branch_convs(const graph::Graph& graph) {
     conv.bias = folded.bias;
     conv.padding = ops[b->spatial].kernel_size() / 2;
     conv.trainable = true;  // the deployed network's parameters, though computed from the branches'
-    for (int op : {b->expand, b->spatial, b->squeeze, b->skip}) drop[op] = true;
-    replacement[i] = std::move(conv);
+    for (int op : {b->expand, b->spatial, b->squeeze, b->skip}) rewritten[op].reset();
+    rewritten[i] = std::move(conv);
+    folded_any = true;
   }
-  if (std::none_of(replacement.begin(), replacement.end(), [](const auto& r) { return r.has_value(); })) return graph;
-
-  // Keep the ops that remain and the values they touch, renumbered in order.
-  graph::Graph out;
-  std::vector<int> index(graph.values.size(), -1);
-  const auto keep_value = [&](int v) {
-    if (index[v] < 0) {
-      index[v] = static_cast<int>(out.values.size());
-      out.values.push_back(graph.values[v]);
-    }
-    return index[v];
-  };
-  for (const auto& [name, v] : graph.inputs) out.inputs.emplace_back(name, keep_value(v));
-  for (size_t i = 0; i < ops.size(); ++i) {
-    if (drop[i]) continue;
-    graph::Op op = replacement[i] ? *replacement[i] : ops[i];
-    for (int& v : op.inputs) v = keep_value(v);
-    op.output = keep_value(op.output);
-    out.ops.push_back(std::move(op));
-  }
-  for (const auto& [name, v] : graph.outputs) out.outputs.emplace_back(name, keep_value(v));
-  return out;
+  return folded_any ? graph::rewrite(graph, rewritten) : graph;
 }
 
 }  // namespace cgsr

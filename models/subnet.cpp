@@ -159,27 +159,10 @@ graph::Graph skip_blocks(const graph::Graph& graph, const std::vector<int>& kept
                "skip_blocks: block " + std::to_string(b) + " changes its input's shape");
     replaced[out] = in;
   }
-  // Keep the ops that remain and the values they touch, renumbered in order.
-  std::vector<int> index(graph.values.size(), -1);
-  graph::Graph out;
-  const auto keep_value = [&](int v) {
-    v = replaced[v];
-    if (index[v] < 0) {
-      index[v] = static_cast<int>(out.values.size());
-      out.values.push_back(graph.values[v]);
-    }
-    return index[v];
-  };
-  for (const auto& [name, v] : graph.inputs) out.inputs.emplace_back(name, keep_value(v));
-  for (size_t i = 0; i < graph.ops.size(); ++i) {
-    if (drop[i]) continue;
-    graph::Op op = graph.ops[i];
-    for (int& v : op.inputs) v = keep_value(v);
-    op.output = keep_value(op.output);
-    out.ops.push_back(std::move(op));
-  }
-  for (const auto& [name, v] : graph.outputs) out.outputs.emplace_back(name, keep_value(v));
-  return out;
+  std::vector<std::optional<graph::Op>> remaining(graph.ops.size());
+  for (size_t i = 0; i < graph.ops.size(); ++i)
+    if (!drop[i]) remaining[i] = graph.ops[i];
+  return graph::rewrite(graph, remaining, replaced);
 }
 
 ChannelSelection subnet_selection(const graph::Graph& graph, const SubnetConfig& sub) {

@@ -76,7 +76,9 @@ TEST(Backbones, ParameterCountsMatchThePublishedNetworks) {
     } else {
       EXPECT_EQ(inference_parameter_count(*net), total_parameter_count(*net));
     }
-    if (const auto reference = reference_params(c)) EXPECT_EQ(inference_parameter_count(*net), *reference);
+    if (const auto reference = reference_params(c)) {
+      EXPECT_EQ(inference_parameter_count(*net), *reference);
+    }
   }
 }
 

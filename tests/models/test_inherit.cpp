@@ -83,7 +83,9 @@ TEST(Inherit, ShrunkChildrenHaveConsistentShapes) {
     torch::NoGradGuard no_grad;
     const auto out = child.network->forward_train(color, info);
     EXPECT_EQ(out.image.sizes().vec(), (std::vector<int64_t>{1, 3, 4 * c.scale, 5 * c.scale}));
-    if (has_hr_features(c.backbone)) EXPECT_EQ(out.geometry.size(1), 2);  // depth + edge
+    if (has_hr_features(c.backbone)) {
+      EXPECT_EQ(out.geometry.size(1), 2);  // depth + edge
+    }
   }
 }
 

@@ -59,7 +59,9 @@ TEST(ModelFile, EveryBackboneRoundTrips) {
     torch::NoGradGuard no_grad;
     const auto a = net->forward_train(color, info), b = loaded.network->forward_train(color, info);
     EXPECT_TRUE(torch::equal(a.image, b.image));
-    if (has_hr_features(c.backbone)) EXPECT_TRUE(torch::equal(a.geometry, b.geometry));
+    if (has_hr_features(c.backbone)) {
+      EXPECT_TRUE(torch::equal(a.geometry, b.geometry));
+    }
   }
   fs::remove_all(dir);
 }
