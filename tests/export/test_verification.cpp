@@ -70,20 +70,24 @@ TEST(Verification, EveryNetworkMatchesOurForwardInEveryRuntime) {
 // What the search and pruning stages produce are plain specs with smaller, uneven widths, fewer
 // blocks and inherited weights: a subnet of an elastic network and a magnitude-pruned network
 // export and verify like any network.
+// SPAN's too: its subnets narrow the branches, then fold them.
 TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
   const auto dir = test::scratch_dir("export-verify-searched-pruned");
-  SRNetwork parent = test::build_network(test::with_rit(default_spec("pan", 2), "lr", "concat"), 500);
-  const ElasticSpace space(parent->spec(), ElasticOptions{});
-  std::mt19937_64 rng(5);
-  SubnetConfig searched = space.sample(rng);
-  while (searched.blocks.size() == static_cast<size_t>(space.total_blocks())) searched = space.sample(rng);
-  const std::vector<std::pair<std::string, SRNetwork>> nets = {
-      {"searched", materialize_subnet(*parent, searched)},
-      {"magnitude_pruned", materialize_subnet(*parent, control_subnet(*parent, ControlKind::Magnitude, 0.5))},
-  };
+  std::vector<std::pair<std::string, SRNetwork>> nets;
+  for (const char* backbone : {"pan", "span"}) {
+    SRNetwork parent = test::build_network(test::with_rit(default_spec(backbone, 2), "lr", "concat"), 500);
+    const ElasticSpace space(parent->spec(), ElasticOptions{});
+    std::mt19937_64 rng(5);
+    SubnetConfig searched = space.sample(rng);
+    while (searched.blocks.size() == static_cast<size_t>(space.total_blocks())) searched = space.sample(rng);
+    nets.emplace_back(std::string(backbone) + "_searched", materialize_subnet(*parent, searched));
+    nets.emplace_back(std::string(backbone) + "_magnitude_pruned",
+                      materialize_subnet(*parent, control_subnet(*parent, ControlKind::Magnitude, 0.5)));
+    for (size_t i = nets.size() - 2; i < nets.size(); ++i)
+      EXPECT_LT(inference_parameter_count(*nets[i].second), inference_parameter_count(*parent)) << nets[i].first;
+  }
   std::vector<VerifyCase> cases;
   for (auto [name, net] : nets) {
-    EXPECT_LT(inference_parameter_count(*net), inference_parameter_count(*parent)) << name;
     for (ExportFormat format : {ExportFormat::Onnx, ExportFormat::TorchScript}) {
       ExportOptions o;
       o.format = format;
@@ -94,8 +98,8 @@ TEST(Verification, SearchedAndPrunedNetworksMatchInEveryRuntime) {
     }
   }
   const VerifyReport report = verify_exports(cases);
-  EXPECT_EQ(report.checks.size(), 8u);  // 2 networks x 2 formats x 2 runtimes
-  EXPECT_EQ(report.passed(), 8) << report.table();
+  EXPECT_EQ(report.checks.size(), 16u);  // 4 networks x 2 formats x 2 runtimes
+  EXPECT_EQ(report.passed(), 16) << report.table();
   std::filesystem::remove_all(dir);
 }
 
