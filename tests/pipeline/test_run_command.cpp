@@ -213,6 +213,39 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
   fs::remove_all(dir);
 }
 
+// The same pipeline on SPAN (a narrow one, so it stays quick): every stage runs on the branches it
+// trains and the folds it deploys, and every exported file matches cgsr in the other runtimes.
+TEST(RunCommand, TheWholePipelineRunsOnSpan) {
+  const auto dir = scratch_dir("run-command-span");
+  const auto config_file = write_config(dir);
+  std::ofstream(dir / "span.yaml") << "backbone: span\nscale: 2\nblocks: 4\nwidths: {features: 12, trunk: 12, fuse: 12, "
+                                      "block0_a: 12, block0_b: 12, block1_a: 12, block1_b: 12, block2_a: 12, block2_b: 12, "
+                                      "block3_a: 12, block3_b: 12}\n";
+  const auto out = dir / "run";
+  const CliResult r = run_cgsr("run --config " + config_file.string() + " --out " + out.string() +
+                               " --threads 2 --seed 3 --set train.model=" + (dir / "span.yaml").string() +
+                               " --set enhance.rit.source=hr_unshuffle --set enhance.geometry.enabled=false");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto actions = stage_actions(r.err);
+  EXPECT_EQ(actions.size(), 13u) << r.err;
+  for (const auto& [stage, action] : actions) EXPECT_EQ(action, "ran") << stage;
+  EXPECT_EQ(read_json(out / "search" / "results.json")["pick"]["spec"].get<std::string>().rfind("span x2", 0), 0u);
+  // The pick keeps SPAN's first and last block, whatever it skips.
+  const auto blocks = read_json(out / "search" / "results.json")["pick"]["subnet"]["blocks"];
+  ASSERT_FALSE(blocks.empty());
+  EXPECT_EQ(blocks.front().get<int>(), 0);
+  EXPECT_EQ(blocks.back().get<int>(), 3);
+  const auto exports = read_json(out / "export" / "results.json")["exports"];
+  ASSERT_GE(exports.size(), 6u);
+  for (const auto& e : exports) {
+    if (!e.contains("verification")) continue;
+    EXPECT_EQ(e["verification"]["failed"].get<int>(), 0) << e["file"];
+    EXPECT_GE(e["verification"]["passed"].get<int>(), 1) << e["file"];
+  }
+  EXPECT_TRUE(fs::exists(out / "export" / "pruned" / "selector.onnx"));
+  fs::remove_all(dir);
+}
+
 TEST(RunCommand, StageConfigErrorsNameTheRunConfigKey) {
   const auto dir = scratch_dir("run-command-errors");
   const auto config_file = write_config(dir);
