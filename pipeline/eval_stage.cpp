@@ -100,7 +100,9 @@ std::vector<ComparisonImage> compare_frames(const std::vector<std::unique_ptr<Up
                                             const std::filesystem::path& dir) {
   std::vector<Upscaler*> networks;
   for (const auto& u : upscalers)
-    if (u->cost(1, 1)) networks.push_back(u.get());  // classic upscalers have no cost and are drawn anyway
+    // Classic upscalers have no cost and nearest, bicubic and fsr are drawn anyway; the BSP border
+    // upsampler is drawn like a network (it is what the comparison is for where it runs).
+    if (u->cost(1, 1) || u->reads_bsp_border()) networks.push_back(u.get());
   std::vector<ComparisonImage> out;
   for (int frame : frames_with_most_edges(evaluated, options.frames)) {
     spdlog::info("image comparison of {} frame {}", data.info().name, frame);

@@ -26,12 +26,17 @@ Mix mix(const std::vector<BspSample>& samples, const std::vector<int>& region) {
 }
 
 Rgb8 mean_color(const std::vector<BspSample>& samples, const std::vector<int>& region) {
+  const bool any_own = std::any_of(region.begin(), region.end(), [&](int i) { return samples[i].own; });
   double sum[3] = {0, 0, 0};
+  int n = 0;
   for (int i : region)
-    for (int c = 0; c < 3; ++c) sum[c] += samples[i].color[c];
+    if (samples[i].own || !any_own) {
+      for (int c = 0; c < 3; ++c) sum[c] += samples[i].color[c];
+      ++n;
+    }
   Rgb8 out;
   for (int c = 0; c < 3; ++c) {
-    const double v = std::clamp(sum[c] / static_cast<double>(region.size()), 0.0, 1.0);
+    const double v = std::clamp(sum[c] / static_cast<double>(n), 0.0, 1.0);
     out[c] = static_cast<uint8_t>(std::lround(v * 255.0));
   }
   return out;

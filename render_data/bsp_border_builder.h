@@ -6,7 +6,8 @@
 // of lowest Gini impurity, with samples on both sides; ties go to the lower priority (the
 // renderer: the nearer triangle's edge, the occluder's silhouette), then to the earlier
 // candidate. A region stops being split when it sees one surface, when no candidate lowers its
-// Gini impurity, or at the maximum depth. Leaves get the mean colour of their samples. Deterministic: the result depends on the inputs' order only.
+// Gini impurity, or at the maximum depth. Leaves get the mean colour of their own samples (those
+// inside the pixel), of all their samples when they have none. Deterministic: the result depends on the inputs' order only.
 
 #include <array>
 #include <optional>
@@ -24,7 +25,8 @@ struct BspBorderSettings {
 };
 
 struct BspSample {
-  double x = 0, y = 0;  // image pixel coordinates, inside the pixel
+  double x = 0, y = 0;  // image pixel coordinates
+  bool own = true;      // inside the pixel; others (just outside) colour only leaves without own samples
   int32_t surface = 0;  // samples with equal values see the same surface
   std::array<float, 3> color{};  // sRGB in [0,1]
 };

@@ -325,30 +325,44 @@ BspBorderImage SceneRenderer::render_bsp_border(const CameraPose& pose, int widt
     return std::equal_range(ctx.triangles.begin(), ctx.triangles.end(), static_cast<uint32_t>(t), ByTriangle{});
   };
 
+  // Each pixel reads its m x m samples and the ring of samples just outside it (its neighbours'
+  // nearest): an edge that runs between two pixels' samples, closer than half a sample spacing to
+  // their boundary, is still seen, and a leaf without samples of its own gets the ring's colour.
+  struct WindowSample {
+    int sx, sy;  // supersampled pixel
+    bool own;
+  };
+  const int H2 = height * m;
   // Rows in parallel, each into its own list: the pixels come out in order whatever the threads.
   std::vector<std::vector<std::pair<int, BspTree>>> rows(height);
   tbb::parallel_for(0, height, [&](int i) {
-    std::vector<int32_t> tri(static_cast<size_t>(m) * m);
-    std::vector<float> depth(tri.size());
+    std::vector<WindowSample> window;
+    std::vector<int32_t> tri;
+    std::vector<float> depth;
     for (int j = 0; j < width; ++j) {
+      window.clear();
+      tri.clear();
+      depth.clear();
       bool mixed = false;
-      for (int b = 0; b < m; ++b)
-        for (int a = 0; a < m; ++a) {
-          const size_t p2 = static_cast<size_t>(i * m + b) * W2 + (j * m + a);
+      for (int sy = i * m - 1; sy <= i * m + m; ++sy)
+        for (int sx = j * m - 1; sx <= j * m + m; ++sx) {
+          if (sx < 0 || sy < 0 || sx >= W2 || sy >= H2) continue;
+          const size_t p2 = static_cast<size_t>(sy) * W2 + sx;
           const int32_t si = ctx.visibility.screen_index[p2];
           const int32_t t = si >= 0 && !g.material_of(ctx.triangles[si].triangle).sky
                                 ? static_cast<int32_t>(ctx.triangles[si].triangle)
                                 : -1;
-          const size_t s = static_cast<size_t>(b) * m + a;
-          tri[s] = t;
-          depth[s] = si >= 0 ? ctx.visibility.depth[p2] : std::numeric_limits<float>::infinity();
-          mixed |= t != tri[0];
+          window.push_back({sx, sy, sx >= j * m && sx < (j + 1) * m && sy >= i * m && sy < (i + 1) * m});
+          tri.push_back(t);
+          depth.push_back(si >= 0 ? ctx.visibility.depth[p2] : std::numeric_limits<float>::infinity());
+          mixed |= t != tri.front();
         }
       if (!mixed) continue;
       const std::vector<int32_t> label = surface_labels(g, tri, cos_crease);
       if (std::all_of(label.begin(), label.end(), [&](int32_t l) { return l == label[0]; })) continue;
 
-      // Candidates: every edge of every triangle seen, the nearest triangle's first on ties.
+      // Candidates: the edges of every triangle seen that cross this pixel, the nearest
+      // triangle's first on ties.
       std::map<int32_t, float> nearest;  // triangle -> its nearest sample depth
       for (size_t s = 0; s < tri.size(); ++s)
         if (tri[s] >= 0) {
@@ -361,34 +375,37 @@ BspBorderImage SceneRenderer::render_bsp_border(const CameraPose& pose, int widt
         for (auto piece = first; piece != last; ++piece)
           for (int k = 0; k < 3; ++k) {
             const int e = (k + 1) % 3;
-            if (const auto line = line_through(piece->x[k] / m, piece->y[k] / m, piece->x[e] / m, piece->y[e] / m))
+            const auto line = line_through(piece->x[k] / m, piece->y[k] / m, piece->x[e] / m, piece->y[e] / m);
+            // A line crosses the unit square when the centre is within half its extent along the normal.
+            if (line && std::abs(line->side(j + 0.5, i + 0.5)) < 0.5 * (std::abs(line->a) + std::abs(line->b)))
               candidates.push_back({*line, d});
           }
       }
+      if (candidates.empty()) continue;
       std::stable_sort(candidates.begin(), candidates.end(),
                        [](const BspCandidate& x, const BspCandidate& y) { return x.priority < y.priority; });
 
-      std::vector<BspSample> samples(tri.size());
-      for (int b = 0; b < m; ++b)
-        for (int a = 0; a < m; ++a) {
-          const size_t s = static_cast<size_t>(b) * m + a;
-          const float cx = static_cast<float>(j * m + a) + 0.5f, cy = static_cast<float>(i * m + b) + 0.5f;
-          const size_t p2 = static_cast<size_t>(i * m + b) * W2 + (j * m + a);
-          const int32_t si = ctx.visibility.screen_index[p2];
-          Vec3 linear;
-          if (tri[s] >= 0) {
-            const ScreenTriangle& st = ctx.triangles[si];
-            linear = shade_surface(ctx, g, *shader_, st, g.material_of(st.triangle), cx, cy).linear;
-          } else {
-            linear = sky_color(scene.sky, pixel_ray(ctx.camera, cx, cy));
-          }
-          samples[s].x = static_cast<double>(cx) / m;
-          samples[s].y = static_cast<double>(cy) / m;
-          samples[s].surface = label[s];
-          samples[s].color = {encode_srgb(linear.x), encode_srgb(linear.y), encode_srgb(linear.z)};
+      std::vector<BspSample> samples(window.size());
+      for (size_t s = 0; s < window.size(); ++s) {
+        samples[s].x = (window[s].sx + 0.5) / m;
+        samples[s].y = (window[s].sy + 0.5) / m;
+        samples[s].surface = label[s];
+        samples[s].own = window[s].own;
+      }
+      // The tree's shape does not depend on colour: shade only the samples of pixels that get one.
+      if (!build_pixel_bsp(samples, candidates, settings.depth)) continue;
+      for (size_t s = 0; s < window.size(); ++s) {
+        const float cx = static_cast<float>(window[s].sx) + 0.5f, cy = static_cast<float>(window[s].sy) + 0.5f;
+        Vec3 linear;
+        if (tri[s] >= 0) {
+          const ScreenTriangle& st = ctx.triangles[ctx.visibility.screen_index[static_cast<size_t>(window[s].sy) * W2 + window[s].sx]];
+          linear = shade_surface(ctx, g, *shader_, st, g.material_of(st.triangle), cx, cy).linear;
+        } else {
+          linear = sky_color(scene.sky, pixel_ray(ctx.camera, cx, cy));
         }
-      if (auto tree = build_pixel_bsp(samples, candidates, settings.depth))
-        rows[i].emplace_back(i * width + j, std::move(*tree));
+        samples[s].color = {encode_srgb(linear.x), encode_srgb(linear.y), encode_srgb(linear.z)};
+      }
+      rows[i].emplace_back(i * width + j, std::move(*build_pixel_bsp(samples, candidates, settings.depth)));
     }
   });
   BspBorderImage out(width, height, settings.depth);
