@@ -44,11 +44,26 @@ TEST(BspBorderUpsampler, OutputPixelsReadTheLeafTheirCentreFallsIn) {
         EXPECT_FLOAT_EQ(out[0][0][Y][X].item<float>(), right ? 1.0f : 0.0f) << "s " << s << " at " << X << "," << Y;
         EXPECT_FLOAT_EQ(out[0][2][Y][X].item<float>(), right ? 0.0f : 1.0f) << "s " << s << " at " << X << "," << Y;
       }
-    // Everything else is bicubic.
-    auto mask = torch::ones({4 * s, 4 * s}, torch::kBool);
-    mask.slice(0, s, 2 * s).slice(1, s, 2 * s).fill_(false);
-    const auto bicubic = upscale_bicubic(lr, s);
-    EXPECT_TRUE(torch::equal(out.masked_select(mask), bicubic.masked_select(mask)));
+    // Everywhere else bicubic, the border pixel's tap reading its leaf on the output centre's
+    // side of the line: the bicubic of the input with that pixel blue left of x = 1.5, red right.
+    auto left = lr.clone(), right = lr.clone();
+    left[0][0][1][1] = 0.0f;
+    left[0][1][1][1] = 0.0f;
+    left[0][2][1][1] = 1.0f;
+    right[0][0][1][1] = 1.0f;
+    right[0][1][1][1] = 0.0f;
+    right[0][2][1][1] = 0.0f;
+    const auto on_left = upscale_bicubic(left, s), on_right = upscale_bicubic(right, s);
+    for (int Y = 0; Y < 4 * s; ++Y)
+      for (int X = 0; X < 4 * s; ++X) {
+        if (Y >= s && Y < 2 * s && X >= s && X < 2 * s) continue;
+        const auto& expected = (X + 0.5) / s < 1.5 ? on_left : on_right;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(out[0][c][Y][X].item<float>(), expected[0][c][Y][X].item<float>(), 1e-5)
+              << "s " << s << " channel " << c << " at " << X << "," << Y;
+      }
+    // Far from the border pixel (no tap reaches it) the grey stays exactly grey.
+    EXPECT_FLOAT_EQ(out[0][1][4 * s - 1][4 * s - 1].item<float>(), 0.5f);
   }
 }
 
@@ -114,8 +129,9 @@ TEST(BspBorderUpsampler, BeatsBicubicOnGeometryEdgesOfRenderedFrames) {
   const double n = static_cast<double>(frames.size());
   const double gain = (bsp_sum - bicubic_sum) / n;
   RecordProperty("edge_gain_db", std::to_string(gain));
-  EXPECT_GT(gain, 1.0) << "BSP " << bsp_sum / n << " dB against bicubic " << bicubic_sum / n << " dB on geometry edges";
-  // Off the edges the two differ only in the border pixels that the dilated edge map misses.
+  // Measured +4.5 dB (frames 1, 3 and 5, depth 2, 4 samples per side); the bound leaves headroom.
+  EXPECT_GT(gain, 3.0) << "BSP " << bsp_sum / n << " dB against bicubic " << bicubic_sum / n << " dB on geometry edges";
+  // Off the edges they differ only around border pixels that the dilated edge map misses.
   EXPECT_GT((bsp_rest - bicubic_rest) / n, -0.1);
 }
 
