@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "render_data/bsp_border_builder.h"
 #include "render_data/bsp_border_file.h"
+#include "render_data/data_check.h"
 #include "render_data/dataset.h"
 #include "render_data/frame_files.h"
 #include "render_data/render_job.h"
@@ -383,9 +384,14 @@ TEST(BspBorderRender, OffByDefaultKeepsFingerprintAndFiles) {
   ASSERT_TRUE(data.frame(1, 0)->bsp_border);
   EXPECT_EQ(data.frame(1, 0)->bsp_border->width(), 64);
   EXPECT_FALSE(data.frame(1, 1)->bsp_border);
-  // A corrupt file is an error naming it when the frame is read.
+  EXPECT_EQ(check_dataset(dir / "with").problem_count(), 0);
+  // A corrupt file is an error naming it when the frame is read, and a problem for data check.
   const auto file = bsp_border_file(dir / "with", {64, 48}, 2);
   write_file_atomic(file, read_file(file).substr(0, 30));
+  const DataCheckReport report = check_dataset(dir / "with");
+  EXPECT_EQ(report.problems.count("bsp_border"), 1u);
+  ASSERT_FALSE(report.messages.empty());
+  EXPECT_NE(report.messages.front().find("000002.bsp"), std::string::npos) << report.messages.front();
   try {
     Dataset::open(dir / "with").frame(2, 0);
     ADD_FAILURE() << "a truncated BSP border file was accepted";
