@@ -40,10 +40,11 @@ class SceneRenderer {
 
   // The sub-pixel BSP border image (bsp_border.h) of the same view at width x height: the view is
   // rasterized again at settings.samples x the size, so every pixel gets samples^2 samples of which
-  // triangle is visible; a pixel whose samples see more than one surface (different meshes, or
-  // triangles of a mesh that meet at a crease or do not touch) gets a BSP whose candidate lines
-  // are the projected edges of the triangles it sees, its leaves the mean colour of their samples,
-  // each shaded as render() shades a pixel centre. Deterministic and independent of the thread count.
+  // triangle is visible (plus the ring of its neighbours' nearest samples); a pixel whose samples
+  // see more than one surface (different meshes, or triangles of a mesh that meet at a crease or
+  // do not touch) gets a BSP whose candidate lines are the projected edges of the triangles it
+  // sees that cross it, its leaves the mean colour of their samples, each shaded as render()
+  // shades a pixel centre. Deterministic and independent of the thread count (docs/bsp_border.md).
   BspBorderImage render_bsp_border(const CameraPose& pose, int width, int height, float near_plane, float far_plane,
                                    const BspBorderSettings& settings) const;
 

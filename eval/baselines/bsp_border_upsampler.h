@@ -3,7 +3,9 @@
 // images (render_data/bsp_border.h). An output pixel whose centre falls in a border pixel of the
 // input takes the colour of the leaf its centre falls in, so the edge stays where the geometry
 // put it; every other output pixel is the bicubic interpolation of the input (interpolation.h,
-// the same pixel-centre convention). The leaves hold 8-bit sRGB like the colour image.
+// the same pixel-centre convention), except that a tap on a border pixel reads that pixel's leaf
+// on the output centre's side of its lines (they extend beyond the pixel): no colour bleeds
+// across an edge into the neighbours. The leaves hold 8-bit sRGB like the colour image.
 
 #include <torch/types.h>
 
