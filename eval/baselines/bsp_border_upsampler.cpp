@@ -3,7 +3,9 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/error.h"
 #include "core/tensor_checks.h"
@@ -52,6 +54,13 @@ torch::Tensor upscale_bsp_border(const torch::Tensor& lr, const std::vector<cons
     if (image.size() == 0) continue;
     float* item = o + k * 3 * plane;
     const float* texels = src + k * 3 * h * w;
+    // Input pixels within 2 of a border pixel: the only ones whose output pixels' taps can touch one.
+    std::vector<uint8_t> near(static_cast<size_t>(h * w), 0);
+    for (size_t i = 0; i < image.size(); ++i) {
+      const int64_t bx = image.pixel(i) % w, by = image.pixel(i) / w;
+      for (int64_t y = std::max<int64_t>(0, by - 2); y <= std::min(h - 1, by + 2); ++y)
+        for (int64_t x = std::max<int64_t>(0, bx - 2); x <= std::min(w - 1, bx + 2); ++x) near[y * w + x] = 1;
+    }
     // Only output pixels whose 4x4 bicubic taps touch a border pixel change.
     tbb::parallel_for(int64_t(0), H, [&](int64_t Y) {
       const double py = (Y + 0.5) / scale;  // the output centre in input pixel coordinates
@@ -60,6 +69,7 @@ torch::Tensor upscale_bsp_border(const torch::Tensor& lr, const std::vector<cons
       for (int t = 0; t < 4; ++t) wy[t] = keys(py - 0.5 - static_cast<double>(y0 + t));
       for (int64_t X = 0; X < W; ++X) {
         const double px = (X + 0.5) / scale;
+        if (!near[(Y / scale) * w + X / scale]) continue;
         const int64_t x0 = static_cast<int64_t>(std::floor(px - 0.5)) - 1;
         // In a border pixel: the leaf the centre falls in.
         if (const BspTree* own = image.at(static_cast<int>(px), static_cast<int>(py))) {
