@@ -351,6 +351,27 @@ RenderJobOptions tiny_job(int bsp_depth) {
   return o;
 }
 
+struct TinyConfig : RenderJobOptions {
+  int64_t seed = 0;
+};
+
+// The fingerprint `cgsr render --config configs/scenes/tiny.yaml --set frames=3` recorded before
+// the option existed (the fuzz seed manifest, written by fuzz/make_seeds.sh) is the one it records now.
+TEST(BspBorderRender, RenderWithoutTheOptionKeepsItsEarlierFingerprint) {
+  config::Schema<TinyConfig> schema;
+  add_render_job_fields(schema);
+  schema.field("seed", &TinyConfig::seed, "seed");
+  config::Document doc = config::Document::load_file(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
+  doc.apply_override("frames=3", "test");
+  const TinyConfig o = config::parse_document(doc, schema);
+  const auto dir = test::temp_dir("bsp_seed_manifest");
+  std::filesystem::copy_file(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/manifest/tiny_manifest.yaml", dir / "manifest.yaml");
+  const DatasetManifest seed_manifest = read_manifest(dir);
+  EXPECT_EQ(render_fingerprint(o, 0), seed_manifest.fingerprint);
+  EXPECT_EQ(seed_manifest.bsp_border_depth, 0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(BspBorderRender, OffByDefaultKeepsFingerprintAndFiles) {
   RenderJobOptions off = tiny_job(0);
   RenderJobOptions on = tiny_job(2);
