@@ -1,5 +1,6 @@
 #include "render_data/bsp_border.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
