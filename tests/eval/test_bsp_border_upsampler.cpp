@@ -4,6 +4,8 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
+
 #include "core/config.h"
 #include "core/error.h"
 #include "core/metrics.h"
@@ -15,6 +17,8 @@
 #include "render_data/frame.h"
 #include "render_data/renderer.h"
 #include "render_data/scene_source.h"
+#include "tests/support/cli_runner.h"
+#include "tests/support/tiny_data.h"
 
 namespace cgsr {
 namespace bsp_upsampler_test {  // named: the tests compile as one unity translation unit
@@ -133,6 +137,35 @@ TEST(BspBorderUpsampler, BeatsBicubicOnGeometryEdgesOfRenderedFrames) {
   EXPECT_GT(gain, 3.0) << "BSP " << bsp_sum / n << " dB against bicubic " << bicubic_sum / n << " dB on geometry edges";
   // Off the edges they differ only around border pixels that the dilated edge map misses.
   EXPECT_GT((bsp_rest - bicubic_rest) / n, -0.1);
+}
+
+// `cgsr eval`: 'classic' includes bsp_border on a data set with BSP border files and leaves it out
+// elsewhere, where naming it is a user error saying how to render them.
+TEST(BspBorderUpsampler, EvalListsItOnlyWhereTheDataHasTheFiles) {
+  const auto dir = test::scratch_dir("bsp-border-eval");
+  const auto render = test::run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) +
+                                     "/configs/scenes/tiny.yaml --set frames=3 --set bsp_border.depth=2 --threads 1 --out " +
+                                     (dir / "data").string());
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const auto names = [](const nlohmann::json& results) {
+    std::vector<std::string> out;
+    for (const auto& e : results.at("evaluations")) out.push_back(e.at("name").get<std::string>());
+    return out;
+  };
+  const std::string common = " --model classic --split all --latency-runs 0 --threads 1 --out ";
+  const auto with = test::run_cgsr("eval --data " + (dir / "data").string() + common + (dir / "with").string());
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  const auto listed = names(test::read_json(dir / "with" / "results.json"));
+  EXPECT_NE(std::find(listed.begin(), listed.end(), "bsp_border"), listed.end());
+  const auto without = test::run_cgsr("eval --data " + test::tiny_data().string() + common + (dir / "without").string());
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  const auto plain = names(test::read_json(dir / "without" / "results.json"));
+  EXPECT_EQ(std::find(plain.begin(), plain.end(), "bsp_border"), plain.end());
+  EXPECT_EQ(plain.size() + 1, listed.size());
+  const auto named = test::run_cgsr("eval --data " + test::tiny_data().string() +
+                                    " --model bsp_border --latency-runs 0 --threads 1 --out " + (dir / "named").string());
+  EXPECT_EQ(named.exit_code, 2);
+  EXPECT_NE(named.all().find("render it with bsp_border: {depth: 2}"), std::string::npos) << named.all();
 }
 
 }  // namespace bsp_upsampler_test
