@@ -192,7 +192,9 @@ std::string check_render(const RenderOptions& options) {
   std::string out;
   for (const auto& job : jobs) {
     const std::string at = job.origin.empty() ? "" : job.origin + ": ";
-    parse_resolutions(job.options.resolutions, at + "resolutions");
+    const auto resolutions = parse_resolutions(job.options.resolutions, at + "resolutions");
+    if (job.options.bsp_border.enabled())
+      check_bsp_border_settings(job.options.bsp_border, resolutions.front().width, resolutions.front().height);
     const SceneBundle bundle = make_scene(job.options.scene, static_cast<uint64_t>(options.seed));
     out += at + "scene '" + bundle.scene.name + "', " + std::to_string(triangle_count(bundle.scene)) + " triangles, " +
            std::to_string(job.options.frames) + " frames at " + join(job.options.resolutions) + "\n";

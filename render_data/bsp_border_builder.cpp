@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <string>
+
+#include "core/config.h"
+#include "core/error.h"
+#include "core/image_header.h"
 
 namespace cgsr {
 namespace {
@@ -92,6 +97,21 @@ struct Builder {
 };
 
 }  // namespace
+
+void check_bsp_border_settings(const BspBorderSettings& settings, int width, int height) {
+  if (settings.depth < 1 || settings.depth > kMaxBspDepth)
+    throw Error("bsp_border", "depth " + config::out_of_range(settings.depth, 1, kMaxBspDepth));
+  if (settings.samples < 2 || settings.samples > 16)
+    throw Error("bsp_border", "samples " + config::out_of_range(settings.samples, 2, 16));
+  if (width <= 0 || height <= 0) throw Error("bsp_border", "image size must be positive");
+  // The supersampled visibility buffer is the pass's memory: bounded like any image cgsr renders.
+  const int64_t m = settings.samples, w = int64_t{width} * m, h = int64_t{height} * m;
+  if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxImagePixels)
+    throw Error("bsp_border", "samples " + std::to_string(m) + " at " + std::to_string(width) + "x" +
+                                  std::to_string(height) + " rasterizes " + std::to_string(w) + "x" + std::to_string(h) +
+                                  " samples, more than cgsr renders (" + std::to_string(kMaxImageSide) + " per side, " +
+                                  std::to_string(kMaxImagePixels) + " in all); use fewer samples");
+}
 
 std::optional<BspLine> line_through(double x0, double y0, double x1, double y1) {
   const double a = y0 - y1, b = x1 - x0;

@@ -36,6 +36,11 @@ struct BspCandidate {
   double priority = 0;  // lower wins ties
 };
 
+// Throws cgsr::Error naming the setting when `settings` cannot build trees for a width x height
+// image: depth outside 1..kMaxBspDepth, samples outside 2..16, or a supersampled view larger
+// than cgsr renders (core/image_header.h).
+void check_bsp_border_settings(const BspBorderSettings& settings, int width, int height);
+
 // Empty when the samples see one surface or no candidate separates them.
 std::optional<BspTree> build_pixel_bsp(const std::vector<BspSample>& samples, const std::vector<BspCandidate>& candidates,
                                        int max_depth);

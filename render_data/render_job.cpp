@@ -87,6 +87,8 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
                                const std::function<void(int, int)>& progress) {
   const auto started = std::chrono::steady_clock::now();
   const auto resolutions = parse_resolutions(o.resolutions, "resolutions");
+  if (o.bsp_border.enabled())  // before anything is written
+    check_bsp_border_settings(o.bsp_border, resolutions.front().width, resolutions.front().height);
   const SceneBundle bundle = make_scene(o.scene, seed);
 
   RenderJobResult result;

@@ -295,11 +295,7 @@ std::vector<int32_t> surface_labels(const SceneGeometry& g, const std::vector<in
 
 BspBorderImage SceneRenderer::render_bsp_border(const CameraPose& pose, int width, int height, float near_plane,
                                                 float far_plane, const BspBorderSettings& settings) const {
-  if (settings.depth < 1 || settings.depth > kMaxBspDepth)
-    throw Error("bsp_border", "depth " + config::out_of_range(settings.depth, 1, kMaxBspDepth));
-  if (settings.samples < 2 || settings.samples > 16)
-    throw Error("bsp_border", "samples " + config::out_of_range(settings.samples, 2, 16));
-  if (width <= 0 || height <= 0) throw Error("render", "image size must be positive");
+  check_bsp_border_settings(settings, width, height);
   const int m = settings.samples;
   // The view again at m x the size: the same projection, so its pixel coordinates are m x ours.
   RenderContext ctx;

@@ -156,6 +156,27 @@ TEST(BspBorder, NoBorderInsideOneSurface) {
   EXPECT_EQ(bsp.size(), 0u);
 }
 
+TEST(BspBorder, RefusesSettingsOutOfRange) {
+  Scene s = test::empty_scene();
+  test::add_quad(s, {0, 0, -5}, {50, 0, 0}, {0, 50, 0}, 3);
+  const SceneRenderer r(s, no_shadows());
+  CameraPose pose;
+  const auto message = [&](int width, int height, BspBorderSettings settings) {
+    try {
+      r.render_bsp_border(pose, width, height, 0.1f, 100.0f, settings);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_NE(message(32, 24, {0, 4}).find("depth"), std::string::npos);
+  EXPECT_NE(message(32, 24, {5, 4}).find("depth"), std::string::npos);
+  EXPECT_NE(message(32, 24, {2, 1}).find("samples"), std::string::npos);
+  const std::string big = message(4096, 2160, {2, 16});
+  EXPECT_NE(big.find("65536x34560 samples"), std::string::npos) << big;
+  EXPECT_NE(big.find("use fewer samples"), std::string::npos) << big;
+}
+
 SceneBundle tiny_scene() {
   const auto doc = config::Document::load_file(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
   const config::Block block{doc.root()["scene"], std::make_shared<config::Document>(doc), "scene"};
