@@ -167,6 +167,9 @@ TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& fram
 
 EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options,
                     const std::function<void(const EvalResult&)>& on_quality) {
+  if (upscaler.reads_bsp_border() && !data.info().bsp_border)
+    throw Error(data.info().root.string(), upscaler.name() + " reads sub-pixel BSP border files, which this data set does "
+                                           "not have: render it with bsp_border: {depth: 2} (docs/bsp_border.md)");
   EvalResult result;
   result.name = upscaler.name();
   result.precision = upscaler.precision();

@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include "core/error.h"
+#include "eval/baselines/bsp_border_upsampler.h"
 #include "eval/baselines/fsr1.h"
 #include "eval/baselines/interpolation.h"
 #include "models/inference.h"
@@ -25,6 +27,27 @@ class ClassicUpscaler : public Upscaler {
   Function f_;
 };
 
+// The BSP border upsampler: the batch's BSP border images besides its colour.
+class BspBorderUpscaler : public Upscaler {
+ public:
+  explicit BspBorderUpscaler(int scale) : scale_(scale) {}
+  std::string name() const override { return "bsp_border"; }
+  int scale() const override { return scale_; }
+  bool reads_bsp_border() const override { return true; }
+  torch::Tensor upscale(const Batch& batch) override {
+    torch::NoGradGuard no_grad;
+    if (batch.lr_bsp_border.empty())
+      throw Error("bsp_border", "the frames carry no sub-pixel BSP border images: evaluate it on a data set rendered "
+                                "with bsp_border: {depth: 2} (docs/bsp_border.md)");
+    std::vector<const BspBorderImage*> images;
+    for (const auto& b : batch.lr_bsp_border) images.push_back(b.get());
+    return upscale_bsp_border(batch.lr_color, images, scale_);
+  }
+
+ private:
+  int scale_;
+};
+
 void add_classic(Registry<ClassicFactory>& r, const std::string& name, ClassicUpscaler::Function f,
                  const std::string& description) {
   r.add(name, [name, f](int scale) { return std::make_unique<ClassicUpscaler>(name, scale, f); }, description);
@@ -40,6 +63,8 @@ const Registry<ClassicFactory>& classic_upscalers() {
     add_classic(r, "lanczos", [](const torch::Tensor& x, int s) { return upscale_lanczos(x, s, 3); }, "Lanczos-3");
     add_classic(r, "fsr", [](const torch::Tensor& x, int s) { return upscale_fsr1(x, s); },
                 "FSR 1.0-style EASU + RCAS");
+    r.add("bsp_border", [](int scale) { return std::make_unique<BspBorderUpscaler>(scale); },
+          "leaves of the renderer's sub-pixel BSP border images, bicubic elsewhere (data sets rendered with bsp_border)");
     return r;
   }();
   return registry;

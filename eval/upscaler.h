@@ -56,9 +56,12 @@ class Upscaler {
   virtual std::optional<PatternChoice> frame_choice() const { return std::nullopt; }
   // The number format its network computes in (models/precision.h).
   virtual Precision precision() const { return Precision::Fp32; }
+  // Reads the batches' sub-pixel BSP border images (Batch::lr_bsp_border): runs only on data
+  // sets rendered with them (DatasetInfo::bsp_border).
+  virtual bool reads_bsp_border() const { return false; }
 };
 
-// nearest, bilinear, bicubic, lanczos, fsr
+// nearest, bilinear, bicubic, lanczos, fsr, bsp_border (only on data sets with BSP border files)
 using ClassicFactory = std::function<std::unique_ptr<Upscaler>(int scale)>;
 const Registry<ClassicFactory>& classic_upscalers();
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the seed inputs in fuzz/corpus/ from what cgsr itself writes: the manifest and
 # the 64x48 files of frame 0 of configs/scenes/tiny.yaml with decompression bombs beside them
+# (and its sub-pixel BSP border file, rendered with bsp_border: {depth: 2})
 # (fuzz/make_bomb_seeds.py), and a small CG-enhanced PAN model file (format version 2) next to
 # the version 1 test fixture (tests/data/model_file_v1.cgsr, which this cgsr can no longer write).
 # Config seeds are the files in configs/ (the fuzz tests read them there) plus the hand-written
@@ -14,8 +15,8 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
 "$cgsr" render --config configs/scenes/tiny.yaml --set frames=3 --out "$work/data" >/dev/null
-rm -rf fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file
-mkdir -p fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file
+rm -rf fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file fuzz/corpus/bsp_border
+mkdir -p fuzz/corpus/manifest fuzz/corpus/frame_files fuzz/corpus/model_file fuzz/corpus/bsp_border
 cp "$work/data/manifest.yaml" fuzz/corpus/manifest/tiny_manifest.yaml
 
 # fuzz_frame_files reads the file kind from the first byte (FileKind order in dataset_manifest.h).
@@ -25,6 +26,10 @@ for kind in color depth normal normal_angle edge id motion; do
   { printf "\\$(printf %03o "$kind_byte")"; cat "$file"; } > "fuzz/corpus/frame_files/$kind.bin"
   kind_byte=$((kind_byte + 1))
 done
+
+"$cgsr" render --config configs/scenes/tiny.yaml --set frames=3 --set bsp_border.depth=2 --out "$work/bsp" >/dev/null
+cp "$work/bsp/64x48/bsp_border/000000.bsp" fuzz/corpus/bsp_border/tiny_000000.bsp
+cp "$work/bsp/manifest.yaml" fuzz/corpus/manifest/tiny_bsp_border_manifest.yaml
 
 # Decompression bombs (PNG, JPEG, EXR), each a few KB declaring 20000x20000 pixels.
 python3 fuzz/make_bomb_seeds.py

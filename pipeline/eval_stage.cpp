@@ -100,7 +100,9 @@ std::vector<ComparisonImage> compare_frames(const std::vector<std::unique_ptr<Up
                                             const std::filesystem::path& dir) {
   std::vector<Upscaler*> networks;
   for (const auto& u : upscalers)
-    if (u->cost(1, 1)) networks.push_back(u.get());  // classic upscalers have no cost and are drawn anyway
+    // Classic upscalers have no cost and nearest, bicubic and fsr are drawn anyway; the BSP border
+    // upsampler is drawn like a network (it is what the comparison is for where it runs).
+    if (u->cost(1, 1) || u->reads_bsp_border()) networks.push_back(u.get());
   std::vector<ComparisonImage> out;
   for (int frame : frames_with_most_edges(evaluated, options.frames)) {
     spdlog::info("image comparison of {} frame {}", data.info().name, frame);
@@ -112,17 +114,30 @@ std::vector<ComparisonImage> compare_frames(const std::vector<std::unique_ptr<Up
 
 nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_dir) {
   std::vector<std::pair<std::string, std::string>> entries;  // (model entry, display name)
+  std::vector<bool> from_classic;                             // listed by 'classic', not by name
   for (size_t i = 0; i < options.models.size(); ++i) {
     const std::string name = options.names.empty() ? "" : options.names[i];
     if (options.models[i] == "classic") {
-      for (const auto& c : classic_upscalers().names()) entries.emplace_back(c, "");
+      for (const auto& c : classic_upscalers().names()) {
+        entries.emplace_back(c, "");
+        from_classic.push_back(true);
+      }
     } else {
       entries.emplace_back(options.models[i], name);
+      from_classic.push_back(false);
     }
   }
   std::vector<std::unique_ptr<Upscaler>> upscalers;
   for (const auto& [entry, name] : entries) upscalers.push_back(make_upscaler(entry, name, options.scale));
   Dataset data = open_for(options.data, upscalers, options.eval.temporal);
+  // 'classic' means the classic upscalers this data set can run: the BSP border upsampler only
+  // where the renderer stored BSP border files (named on its own, evaluate() says why it cannot run).
+  if (!data.info().bsp_border) {
+    std::vector<std::unique_ptr<Upscaler>> kept;
+    for (size_t i = 0; i < upscalers.size(); ++i)
+      if (!(from_classic[i] && upscalers[i]->reads_bsp_border())) kept.push_back(std::move(upscalers[i]));
+    upscalers = std::move(kept);
+  }
   if (!options.scene.empty()) data = data.scene(options.scene);
   upscalers = in_precisions(std::move(upscalers), options.precisions, data, options.calibration);
   std::vector<EvalResult> results;

@@ -24,7 +24,8 @@ config::Schema<SceneSetEntry> scene_set_entry_schema() {
 }
 
 // The keys that each scene's own config sets in a scene set.
-const std::vector<std::string> kPerSceneKeys = {"frames", "resolutions", "shadows", "shadow_map_size", "edges"};
+const std::vector<std::string> kPerSceneKeys = {"frames", "resolutions", "shadows", "shadow_map_size", "edges",
+                                               "bsp_border"};
 }  // namespace
 
 config::Schema<RenderOptions> render_schema() {
@@ -83,8 +84,27 @@ nlohmann::ordered_json sizes_json(const RenderJobResult& r) {
     auto& entry = sizes[r.manifest.resolutions[i].name()];
     entry["total"] = r.manifest.bytes_per_frame[i];
     for (size_t k = 0; k < kinds.size(); ++k) entry[file_kind_name(kinds[k])] = r.bytes_per_kind[i][k];
+    if (i == 0 && r.manifest.bsp_border_depth > 0) entry["bsp_border"] = r.bsp_border_bytes;
   }
   return sizes;
+}
+
+// The memory cost of the BSP border files against the colour image they refine; null without them.
+nlohmann::ordered_json bsp_border_json(const RenderJobResult& r) {
+  if (r.manifest.bsp_border_depth == 0) return nullptr;
+  const Resolution& lr = r.manifest.resolutions.front();
+  const double raw = 3.0 * lr.width * lr.height;
+  const double png = r.bytes_per_kind[0][static_cast<size_t>(FileKind::Color)];
+  return {{"resolution", lr.name()},
+          {"depth", r.manifest.bsp_border_depth},
+          {"samples", r.manifest.bsp_border_samples},
+          {"bytes_per_frame", r.bsp_border_bytes},
+          {"border_pixel_fraction", r.bsp_border_fraction},
+          {"lines_per_border_pixel", r.bsp_border_lines},
+          {"color_raw_bytes", raw},
+          {"color_png_bytes_per_frame", png},
+          {"fraction_of_color_raw", r.bsp_border_bytes / raw},
+          {"fraction_of_color_png", png > 0 ? r.bsp_border_bytes / png : 0.0}};
 }
 
 // What every render reports, of one scene or a set.
@@ -129,6 +149,7 @@ Rendered render_scene_set(const RenderOptions& options, const std::filesystem::p
                            {"resumed", s.skipped},
                            {"triangles", s.triangles},
                            {"bytes_per_frame", sizes_json(s)}});
+    if (s.manifest.bsp_border_depth > 0) j["scenes"].back()["bsp_border"] = bsp_border_json(s);
     std::string sizes;
     for (size_t k = 0; k < s.manifest.resolutions.size(); ++k)
       sizes += (k ? ", " : "") + s.manifest.resolutions[k].name() + " " + human_bytes(s.manifest.bytes_per_frame[k]);
@@ -147,6 +168,7 @@ Rendered render_one_scene(const RenderOptions& options, const std::filesystem::p
   nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
   j["triangles"] = r.triangles;
   j["bytes_per_frame"] = sizes_json(r);
+  if (r.manifest.bsp_border_depth > 0) j["bsp_border"] = bsp_border_json(r);
   std::printf("rendered %d frame(s) (%d resumed) of '%s' into %s in %.1f s\n", r.rendered, r.skipped,
               r.manifest.name.c_str(), out.string().c_str(), r.seconds);
   for (size_t i = 0; i < r.manifest.resolutions.size(); ++i)
@@ -170,7 +192,9 @@ std::string check_render(const RenderOptions& options) {
   std::string out;
   for (const auto& job : jobs) {
     const std::string at = job.origin.empty() ? "" : job.origin + ": ";
-    parse_resolutions(job.options.resolutions, at + "resolutions");
+    const auto resolutions = parse_resolutions(job.options.resolutions, at + "resolutions");
+    if (job.options.bsp_border.enabled())
+      check_bsp_border_settings(job.options.bsp_border, resolutions.front().width, resolutions.front().height);
     const SceneBundle bundle = make_scene(job.options.scene, static_cast<uint64_t>(options.seed));
     out += at + "scene '" + bundle.scene.name + "', " + std::to_string(triangle_count(bundle.scene)) + " triangles, " +
            std::to_string(job.options.frames) + " frames at " + join(job.options.resolutions) + "\n";

@@ -5,11 +5,14 @@
 
 #include <torch/types.h>
 
+#include <memory>
 #include <vector>
 
 #include "render_data/render_channels.h"
 
 namespace cgsr {
+
+class BspBorderImage;  // bsp_border.h
 
 struct Batch {
   torch::Tensor lr_color;  // [N, 3, h, w] float32 in [0,1]
@@ -20,6 +23,9 @@ struct Batch {
   DepthEncoding depth_encoding = DepthEncoding::Log;  // of the depth channel in lr_info/hr_info
   std::vector<int> frames;  // frame index of each item in the sequence
   int scale = 2;
+  // Whole frames of a data set with sub-pixel BSP border files: each item's LR BSP border image
+  // (frame_batch fills it; empty for patches and for data sets without them).
+  std::vector<std::shared_ptr<const BspBorderImage>> lr_bsp_border;
 };
 
 }  // namespace cgsr

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/tensor_checks.h"
+#include "render_data/bsp_border_file.h"
 #include "render_data/frame_files.h"
 
 namespace cgsr {
@@ -121,6 +122,22 @@ void check_cgsr_files(const fs::path& root, const DatasetManifest& m, Collector&
       }
       c.frame(f);
     }
+    if (m.bsp_border_depth > 0) {  // the BSP border file of the smallest resolution
+      const fs::path path = bsp_border_file(root, m.resolutions.front(), frame);
+      {
+        std::lock_guard<std::mutex> lock(c.mutex);
+        ++c.report.files_checked;
+      }
+      try {
+        const BspBorderImage image = read_bsp_border_file(path, frame, m.resolutions.front());
+        if (image.max_depth() != m.bsp_border_depth)
+          c.problem("bsp_border", path.string() + ": frame " + std::to_string(frame) + ": max_depth " +
+                                      std::to_string(image.max_depth()) + ", the manifest says depth " +
+                                      std::to_string(m.bsp_border_depth));
+      } catch (const Error& e) {
+        c.problem(fs::exists(path) ? "bsp_border" : "missing", e.what());
+      }
+    }
   });
 }
 
@@ -159,6 +176,7 @@ DataCheckReport check_dataset(const fs::path& path, const DatasetOpenOptions& op
     report.frames = m.frames;
     report.resolutions = m.resolutions;
     for (FileKind k : all_file_kinds()) report.channels.push_back(file_kind_name(k));
+    if (m.bsp_border_depth > 0) report.channels.push_back("bsp_border");
     report.split_train = static_cast<int>(m.split.train.size());
     report.split_val = static_cast<int>(m.split.val.size());
     report.split_test = static_cast<int>(m.split.test.size());

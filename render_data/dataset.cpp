@@ -145,6 +145,8 @@ class CgsrDataset : public FrameSource {
     for (const auto& p : parts_)
       info_.scenes.push_back({p.name, p.first_frame, p.manifest.frames, p.manifest.near_plane, p.manifest.far_plane,
                               p.manifest.vfov, p.weight});
+    info_.bsp_border = std::all_of(parts_.begin(), parts_.end(),
+                                   [](const ScenePart& p) { return p.manifest.bsp_border_depth > 0; });
   }
   const DatasetInfo& info() const override { return info_; }
   Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {

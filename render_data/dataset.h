@@ -81,6 +81,9 @@ struct DatasetInfo {
   // without scenes leave it empty and get one scene of every frame named after the data set.
   std::vector<SceneInfo> scenes;
   std::vector<std::string> notes;       // e.g. "tile-grid lines removed from edges"
+  // Every frame has a sub-pixel BSP border image at resolutions[0] (Frame::bsp_border; cgsr data
+  // sets rendered with bsp_border).
+  bool bsp_border = false;
 };
 
 // What a layout implements: metadata, and one frame at one resolution with the given channels

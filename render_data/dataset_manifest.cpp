@@ -178,6 +178,15 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
     out << YAML::EndMap;
   }
   out << YAML::EndMap;
+  if (m.bsp_border_depth > 0) {
+    out << YAML::Key << "bsp_border" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "resolution" << YAML::Value << m.resolutions.front().name();
+    out << YAML::Key << "depth" << YAML::Value << m.bsp_border_depth;
+    out << YAML::Key << "samples" << YAML::Value << m.bsp_border_samples;
+    out << YAML::Key << "path" << YAML::Value << "<resolution>/bsp_border/<frame:06d>.bsp";
+    out << YAML::Key << "encoding" << YAML::Value << "cgsr sub-pixel BSP border file version 1 (docs/bsp_border.md)";
+    out << YAML::EndMap;
+  }
   write_split(out, m.split);
   if (!m.bytes_per_frame.empty()) {
     out << YAML::Key << "bytes_per_frame" << YAML::Value << YAML::BeginMap;
@@ -286,6 +295,20 @@ DatasetManifest read_manifest(const fs::path& root) {
   for (size_t i = 1; i < m.resolutions.size(); ++i)
     if (m.resolutions[i].width <= m.resolutions[i - 1].width)
       at.child("resolutions").fail(n["resolutions"], "resolutions must be listed in ascending order");
+  if (const YAML::Node bsp = n["bsp_border"]) {
+    const config::Cursor bat = at.child("bsp_border");
+    if (!bsp.IsMap()) bat.fail(bsp, "expected a map {resolution, depth, samples, ...}, got " + config::detail::describe(bsp));
+    for (const char* key : {"resolution", "depth", "samples"})
+      if (!bsp[key]) bat.child(key).fail(bsp, std::string("missing required key '") + key + "'");
+    const auto resolution = config::Codec<std::string>::decode(bsp["resolution"], bat.child("resolution"));
+    if (resolution != m.resolutions.front().name())
+      bat.child("resolution").fail(bsp["resolution"], "is " + resolution + ", but BSP border files are stored at the "
+                                                      "smallest resolution, " + m.resolutions.front().name());
+    m.bsp_border_depth = config::Codec<int>::decode(bsp["depth"], bat.child("depth"));
+    config::detail::require_in_range(m.bsp_border_depth, 1, 4, bsp["depth"], bat.child("depth"));
+    m.bsp_border_samples = config::Codec<int>::decode(bsp["samples"], bat.child("samples"));
+    config::detail::require_in_range(m.bsp_border_samples, 2, 16, bsp["samples"], bat.child("samples"));
+  }
   return m;
 }
 

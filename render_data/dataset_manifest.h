@@ -73,6 +73,10 @@ struct DatasetManifest {
   uint64_t seed = 0;
   FrameSplit split;
   std::vector<double> bytes_per_frame;  // per resolution, mean over the frames (complete datasets)
+  // Sub-pixel BSP border files (render_data/bsp_border_file.h) of every frame at the smallest
+  // resolution, with the depth and samples per pixel side they were built with; depth 0: none
+  // (and no `bsp_border` key, so manifests without them are written as before).
+  int bsp_border_depth = 0, bsp_border_samples = 0;
   // Multi-scene data sets only (then the frames live in the scenes' directories, and the planes,
   // field of view, seed and sizes are each scene's own).
   std::vector<ManifestScene> scenes;

@@ -3,6 +3,7 @@
 #include <torch/torch.h>
 
 #include "core/error.h"
+#include "render_data/bsp_border.h"
 
 namespace cgsr {
 
@@ -47,6 +48,7 @@ size_t Frame::bytes() const {
   size_t n = 0;
   for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion})
     if (t->defined()) n += t->numel() * t->element_size();
+  if (bsp_border) n += bsp_border->bytes();
   return n;
 }
 

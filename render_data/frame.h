@@ -7,6 +7,7 @@
 
 #include <torch/types.h>
 
+#include <memory>
 #include <vector>
 
 #include "render_data/edges.h"
@@ -14,6 +15,8 @@
 #include "render_data/render_channels.h"
 
 namespace cgsr {
+
+class BspBorderImage;  // bsp_border.h
 
 struct Frame {
   int width = 0, height = 0;
@@ -24,6 +27,10 @@ struct Frame {
   torch::Tensor edge;          // uint8 [1,H,W], 0 or 1
   torch::Tensor motion;        // float32 [2,H,W], pixels (render_channels.h)
   DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
+  // The sub-pixel BSP border image, when the data set stores one at this resolution (cgsr data
+  // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are
+  // in the whole frame's pixel coordinates.
+  std::shared_ptr<const BspBorderImage> bsp_border;
 
   bool has(RenderChannel channel) const;
   std::vector<RenderChannel> channels() const;  // present channels, in the fixed order

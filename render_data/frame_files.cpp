@@ -10,6 +10,7 @@
 #include "core/image_header.h"
 #include "core/image_io.h"
 #include "core/tensor_checks.h"
+#include "render_data/bsp_border_file.h"
 
 namespace cgsr {
 namespace fs = std::filesystem;
@@ -209,6 +210,10 @@ Frame read_dataset_frame(const fs::path& root, const DatasetManifest& m, int fra
   if (want(RenderChannel::Edge)) files.run([&] { f.edge = read_edge_file(m.file(root, frame, res, FileKind::Edge), frame, r); });
   if (want(RenderChannel::Motion))
     files.run([&] { f.motion = read_motion_file(m.file(root, frame, res, FileKind::Motion), frame, r); });
+  if (m.bsp_border_depth > 0 && res == 0)  // small files: read whenever the data set has them
+    files.run([&] {
+      f.bsp_border = std::make_shared<const BspBorderImage>(read_bsp_border_file(bsp_border_file(root, r, frame), frame, r));
+    });
   files.wait();  // rethrows the first decoding error
   return f;
 }

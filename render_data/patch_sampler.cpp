@@ -249,7 +249,9 @@ Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<R
   const SceneInfo& scene = data.scene_of(frame);
   std::vector<Item> items{make_item(*l, *h, 0, 0, l->width, l->height, scale, channels, depth, scene.near_plane,
                                     scene.far_plane, nullptr)};
-  return stack(items, channels, depth, {frame}, scale);
+  Batch b = stack(items, channels, depth, {frame}, scale);
+  if (l->bsp_border) b.lr_bsp_border.push_back(l->bsp_border);
+  return b;
 }
 
 FrameIterator::FrameIterator(Dataset data, FrameIteratorOptions options) : data_(std::move(data)), options_(std::move(options)) {

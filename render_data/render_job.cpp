@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "render_data/bsp_border_file.h"
 #include "render_data/frame_files.h"
 #include "render_data/renderer.h"
 #include "render_data/scene_source.h"
@@ -23,6 +24,16 @@ config::Schema<EdgeSettings> edge_settings_schema() {
   s.field("crease_angle", &EdgeSettings::crease_angle, "normal angle between neighbours that makes a crease edge, degrees")
       .range(1, 180);
   s.field("id_changes", &EdgeSettings::id_changes, "object id changes are edges");
+  return s;
+}
+
+config::Schema<BspBorderSettings> bsp_border_settings_schema() {
+  config::Schema<BspBorderSettings> s;
+  s.field("depth", &BspBorderSettings::depth, "lines on a root-to-leaf path of a border pixel's BSP (0: no BSP files)")
+      .range(0, kMaxBspDepth);
+  s.field("samples", &BspBorderSettings::samples,
+          "samples per pixel side that find the surfaces in a pixel and colour the leaves (samples^2 per pixel)")
+      .range(2, 16);
   return s;
 }
 
@@ -55,6 +66,9 @@ std::string render_fingerprint(const RenderJobOptions& o, uint64_t seed) {
                      std::to_string(o.edges.depth_threshold) + "|" + std::to_string(o.edges.crease_angle) + "|" +
                      std::to_string(o.edges.id_changes);
   for (const auto& r : o.resolutions) text += "|" + r;
+  // Only when on: renders without BSP files keep the fingerprints they had before the option.
+  if (o.bsp_border.enabled())
+    text += "|bsp_border " + std::to_string(o.bsp_border.depth) + " " + std::to_string(o.bsp_border.samples);
   return hex_fingerprint(text);
 }
 
@@ -73,6 +87,8 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
                                const std::function<void(int, int)>& progress) {
   const auto started = std::chrono::steady_clock::now();
   const auto resolutions = parse_resolutions(o.resolutions, "resolutions");
+  if (o.bsp_border.enabled())  // before anything is written
+    check_bsp_border_settings(o.bsp_border, resolutions.front().width, resolutions.front().height);
   const SceneBundle bundle = make_scene(o.scene, seed);
 
   RenderJobResult result;
@@ -87,6 +103,10 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   m.scene_source = config::block_type(o.scene);
   m.seed = seed;
   m.split = make_split(o.frames);
+  if (o.bsp_border.enabled()) {
+    m.bsp_border_depth = o.bsp_border.depth;
+    m.bsp_border_samples = o.bsp_border.samples;
+  }
 
   fs::create_directories(out);
   check_resumable(out, m.fingerprint);
@@ -103,17 +123,35 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
 
   const auto& kinds = all_file_kinds();
   result.bytes_per_kind.assign(resolutions.size(), std::vector<double>(kinds.size(), 0.0));
+  const bool bsp = o.bsp_border.enabled();
+  const Resolution& lr = resolutions.front();
+  size_t bsp_pixels = 0, bsp_lines = 0;
   for (int f = 0; f < o.frames; ++f) {
-    if (frame_complete(out, resolutions, f)) {
+    const fs::path bsp_file = bsp_border_file(out, lr, f);
+    if (frame_complete(out, resolutions, f) && (!bsp || fs::exists(bsp_file))) {
       ++result.skipped;
+      if (bsp) {  // counted from the file, so resumed frames count too
+        const BspBorderImage image = read_bsp_border_file(bsp_file, f, lr);
+        bsp_pixels += image.size();
+        bsp_lines += image.line_count();
+      }
     } else {
       const CameraPose pose = bundle.camera.at_frame(f, o.frames), previous = bundle.camera.at_frame(f - 1, o.frames);
       for (const auto& r : resolutions) {
         const GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane);
         write_frame_files(out, r, f, g);
       }
+      // After the frame's images: an existing BSP file marks the frame complete.
+      if (bsp) {
+        const BspBorderImage image =
+            renderer.render_bsp_border(pose, lr.width, lr.height, m.near_plane, m.far_plane, o.bsp_border);
+        write_bsp_border_file(bsp_file, image);
+        bsp_pixels += image.size();
+        bsp_lines += image.line_count();
+      }
       ++result.rendered;
     }
+    if (bsp) result.bsp_border_bytes += static_cast<double>(fs::file_size(bsp_file));
     // Sizes from disk, so resumed frames count too.
     for (size_t ri = 0; ri < resolutions.size(); ++ri)
       for (size_t k = 0; k < kinds.size(); ++k)
@@ -125,6 +163,12 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
     for (auto& b : result.bytes_per_kind[ri]) total += (b /= o.frames);
     m.bytes_per_frame.push_back(total);
   }
+  if (bsp) {
+    result.bsp_border_bytes /= o.frames;
+    m.bytes_per_frame.front() += result.bsp_border_bytes;
+    result.bsp_border_fraction = static_cast<double>(bsp_pixels) / (static_cast<double>(lr.width) * lr.height * o.frames);
+    result.bsp_border_lines = bsp_pixels ? static_cast<double>(bsp_lines) / static_cast<double>(bsp_pixels) : 0.0;
+  }
   write_manifest(out, m);  // with the sizes, still complete: false (finish_render)
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (result.skipped > 0) spdlog::info("resumed: {} frame(s) were already complete", result.skipped);
@@ -132,7 +176,16 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
     std::string parts;
     for (size_t k = 0; k < kinds.size(); ++k)
       parts += (k ? ", " : "") + file_kind_name(kinds[k]) + " " + human_bytes(result.bytes_per_kind[ri][k]);
+    if (bsp && ri == 0) parts += ", bsp_border " + human_bytes(result.bsp_border_bytes);
     spdlog::info("size per frame at {}: {} ({})", resolutions[ri].name(), human_bytes(m.bytes_per_frame[ri]), parts);
+  }
+  if (bsp) {
+    const double raw = 3.0 * lr.width * lr.height;  // the colour image as 8-bit RGB
+    const double png = result.bytes_per_kind[0][static_cast<size_t>(FileKind::Color)];
+    spdlog::info("bsp_border at {}: {:.2f}% of the pixels are border pixels, {:.2f} lines each; {} per frame = {:.1f}% "
+                 "of the colour image's {} raw bytes ({:.1f}% of its PNG)",
+                 lr.name(), 100.0 * result.bsp_border_fraction, result.bsp_border_lines, human_bytes(result.bsp_border_bytes),
+                 100.0 * result.bsp_border_bytes / raw, static_cast<int64_t>(raw), 100.0 * result.bsp_border_bytes / png);
   }
   return result;
 }

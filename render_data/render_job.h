@@ -11,6 +11,8 @@
 //   shadows: true
 //   shadow_map_size: 1024
 //   edges: {depth_threshold: 0.08, crease_angle: 40, id_changes: true}
+//   bsp_border: {depth: 2, samples: 4}  # sub-pixel BSP border files at the smallest resolution
+//                                       # (bsp_border.h); depth 0 (the default): none
 //   scene: {type: procedural, ...}      # scene_source.h
 
 #include <filesystem>
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "render_data/bsp_border_builder.h"
 #include "render_data/dataset_manifest.h"
 #include "render_data/edges.h"
 
@@ -31,10 +34,12 @@ struct RenderJobOptions {
   bool shadows = true;
   int shadow_map_size = 1024;
   EdgeSettings edges;
+  BspBorderSettings bsp_border;
   config::Block scene;
 };
 
 config::Schema<EdgeSettings> edge_settings_schema();
+config::Schema<BspBorderSettings> bsp_border_settings_schema();
 
 // Adds the render-job keys to a command schema whose options struct derives from RenderJobOptions.
 // `scene_required` false: the caller checks `scene` (e.g. against a scene set).
@@ -50,6 +55,10 @@ void add_render_job_fields(config::Schema<T>& s, bool scene_required = true) {
       .range(16, 8192);
   s.section("edges", static_cast<EdgeSettings T::*>(&RenderJobOptions::edges), edge_settings_schema(),
             "edge detection thresholds");
+  s.section("bsp_border", static_cast<BspBorderSettings T::*>(&RenderJobOptions::bsp_border), bsp_border_settings_schema(),
+            "sub-pixel BSP border files at the smallest resolution (depth 0: none)");
+  // Off, the resolved config (and so `cgsr run`'s render stage hash) is what it was before the key.
+  s.omit_when("bsp_border", [](const T& o) { return !o.bsp_border.enabled(); });
   s.block("scene", static_cast<config::Block T::*>(&RenderJobOptions::scene), "scene source {type: procedural, ...}");
   if (scene_required)
     s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {
@@ -68,6 +77,9 @@ struct RenderJobResult {
   size_t triangles = 0;
   // Mean bytes per frame, per resolution and per file kind (all_file_kinds() order).
   std::vector<std::vector<double>> bytes_per_kind;
+  // With BSP border files: their mean bytes per frame, the share of the smallest resolution's
+  // pixels that have a tree, and lines per tree (means over the frames).
+  double bsp_border_bytes = 0, bsp_border_fraction = 0, bsp_border_lines = 0;
 };
 
 // Renders into `out` (created if needed). `progress` is called after each frame (done, total).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "core/config.h"
 #include "core/error.h"
@@ -142,11 +143,13 @@ Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlan
   return linear;
 }
 
-// A surface at pixel p: its shaded linear colour (with fog), returned, and its view-space depth,
-// normal and angle, ids and motion written.
-Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
-                     const ScreenTriangle& tri, const Material& mat, const GBufferPlanes& px, size_t p, float cx,
-                     float cy) {
+// A surface seen at pixel coordinates (cx, cy): its shaded linear colour (with fog), world point
+// and normal (facing the camera).
+struct ShadedPoint {
+  Vec3 linear, world, normal;
+};
+ShadedPoint shade_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
+                          const ScreenTriangle& tri, const Material& mat, float cx, float cy) {
   const FrameCamera& cam = ctx.camera;
   const Scene& scene = g.scene();
   // World space: perspective-correct interpolation of the original triangle's vertices.
@@ -182,6 +185,18 @@ Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const Sur
     const float f = 1.0f - std::exp(-scene.fog.density * std::max(0.0f, dist - scene.fog.start));
     linear = lerp(linear, scene.fog.color, f);
   }
+  return {linear, world, n};
+}
+
+// A surface at pixel p: its shaded linear colour (with fog), returned, and its view-space depth,
+// normal and angle, ids and motion written.
+Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
+                     const ScreenTriangle& tri, const Material& mat, const GBufferPlanes& px, size_t p, float cx,
+                     float cy) {
+  const FrameCamera& cam = ctx.camera;
+  const ShadedPoint shaded = shade_surface(ctx, g, shader, tri, mat, cx, cy);
+  const Vec3 world = shaded.world, n = shaded.normal;
+  const Vec3 linear = shaded.linear;
 
   // View space: depth, normal and its angle to the direction towards the camera.
   px.depth[p] = ctx.visibility.depth[p];
@@ -236,6 +251,163 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
 
   out.edge = detect_edges(out.depth, out.normal, out.object_id, settings_.edges);
   return std::move(out);
+}
+
+namespace {
+
+// The surfaces of one pixel's samples: triangles of one mesh that share a vertex and meet at
+// less than the crease angle are one surface (a tessellated wall is not a border); anything else
+// (another mesh, a crease, a fold of the same mesh, the sky) is another.
+std::vector<int32_t> surface_labels(const SceneGeometry& g, const std::vector<int32_t>& triangles, float cos_crease) {
+  std::vector<int32_t> distinct(triangles);
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  std::vector<size_t> root(distinct.size());
+  for (size_t i = 0; i < root.size(); ++i) root[i] = i;
+  const auto find = [&](size_t i) {
+    while (root[i] != i) i = root[i];
+    return i;
+  };
+  const auto face_normal = [&](int32_t t) {
+    const uint32_t* v = &g.indices[static_cast<size_t>(t) * 3];
+    return normalize(cross(g.positions[v[1]] - g.positions[v[0]], g.positions[v[2]] - g.positions[v[0]]));
+  };
+  for (size_t i = 0; i < distinct.size(); ++i)
+    for (size_t j = i + 1; j < distinct.size(); ++j) {
+      const int32_t a = distinct[i], b = distinct[j];
+      if (a < 0 || b < 0 || g.triangle_mesh[a] != g.triangle_mesh[b]) continue;
+      const uint32_t* va = &g.indices[static_cast<size_t>(a) * 3];
+      const uint32_t* vb = &g.indices[static_cast<size_t>(b) * 3];
+      bool shared = false;
+      for (int x = 0; x < 3; ++x)
+        for (int y = 0; y < 3; ++y) shared |= va[x] == vb[y];
+      if (shared && std::abs(dot(face_normal(a), face_normal(b))) >= cos_crease) root[find(j)] = find(i);
+    }
+  std::vector<int32_t> labels(triangles.size());
+  for (size_t s = 0; s < triangles.size(); ++s) {
+    const size_t i = std::lower_bound(distinct.begin(), distinct.end(), triangles[s]) - distinct.begin();
+    labels[s] = distinct[find(i)];
+  }
+  return labels;
+}
+
+}  // namespace
+
+BspBorderImage SceneRenderer::render_bsp_border(const CameraPose& pose, int width, int height, float near_plane,
+                                                float far_plane, const BspBorderSettings& settings) const {
+  check_bsp_border_settings(settings, width, height);
+  const int m = settings.samples;
+  // The view again at m x the size: the same projection, so its pixel coordinates are m x ours.
+  RenderContext ctx;
+  ctx.camera = make_frame_camera(pose, width * m, height * m, near_plane, far_plane);
+  ctx.previous = ctx.camera;
+  const SceneGeometry& g = geometry_;
+  transform_vertices(g, ctx);
+  rasterize_geometry(g, near_plane, width * m, height * m, settings_.tile_size, ctx);
+  const int W2 = width * m;
+  const float cos_crease = std::cos(settings_.edges.crease_angle * 3.14159265358979f / 180.0f);
+  const Scene& scene = g.scene();
+
+  // Screen triangles come out of setup in the order of the original triangles: a triangle's
+  // pieces (after near-plane clipping) are a run found by binary search.
+  struct ByTriangle {
+    bool operator()(const ScreenTriangle& a, uint32_t t) const { return a.triangle < t; }
+    bool operator()(uint32_t t, const ScreenTriangle& a) const { return t < a.triangle; }
+  };
+  CGSR_CHECK(std::is_sorted(ctx.triangles.begin(), ctx.triangles.end(),
+                            [](const ScreenTriangle& a, const ScreenTriangle& b) { return a.triangle < b.triangle; }),
+             "screen triangles out of triangle order");
+  const auto pieces = [&](int32_t t) {
+    return std::equal_range(ctx.triangles.begin(), ctx.triangles.end(), static_cast<uint32_t>(t), ByTriangle{});
+  };
+
+  // Each pixel reads its m x m samples and the ring of samples just outside it (its neighbours'
+  // nearest): an edge that runs between two pixels' samples, closer than half a sample spacing to
+  // their boundary, is still seen, and a leaf without samples of its own gets the ring's colour.
+  struct WindowSample {
+    int sx, sy;  // supersampled pixel
+    bool own;
+  };
+  const int H2 = height * m;
+  // Rows in parallel, each into its own list: the pixels come out in order whatever the threads.
+  std::vector<std::vector<std::pair<int, BspTree>>> rows(height);
+  tbb::parallel_for(0, height, [&](int i) {
+    std::vector<WindowSample> window;
+    std::vector<int32_t> tri;
+    std::vector<float> depth;
+    for (int j = 0; j < width; ++j) {
+      window.clear();
+      tri.clear();
+      depth.clear();
+      bool mixed = false;
+      for (int sy = i * m - 1; sy <= i * m + m; ++sy)
+        for (int sx = j * m - 1; sx <= j * m + m; ++sx) {
+          if (sx < 0 || sy < 0 || sx >= W2 || sy >= H2) continue;
+          const size_t p2 = static_cast<size_t>(sy) * W2 + sx;
+          const int32_t si = ctx.visibility.screen_index[p2];
+          const int32_t t = si >= 0 && !g.material_of(ctx.triangles[si].triangle).sky
+                                ? static_cast<int32_t>(ctx.triangles[si].triangle)
+                                : -1;
+          window.push_back({sx, sy, sx >= j * m && sx < (j + 1) * m && sy >= i * m && sy < (i + 1) * m});
+          tri.push_back(t);
+          depth.push_back(si >= 0 ? ctx.visibility.depth[p2] : std::numeric_limits<float>::infinity());
+          mixed |= t != tri.front();
+        }
+      if (!mixed) continue;
+      const std::vector<int32_t> label = surface_labels(g, tri, cos_crease);
+      if (std::all_of(label.begin(), label.end(), [&](int32_t l) { return l == label[0]; })) continue;
+
+      // Candidates: the edges of every triangle seen that cross this pixel, the nearest
+      // triangle's first on ties.
+      std::map<int32_t, float> nearest;  // triangle -> its nearest sample depth
+      for (size_t s = 0; s < tri.size(); ++s)
+        if (tri[s] >= 0) {
+          auto [it, inserted] = nearest.emplace(tri[s], depth[s]);
+          if (!inserted) it->second = std::min(it->second, depth[s]);
+        }
+      std::vector<BspCandidate> candidates;
+      for (const auto& [t, d] : nearest) {
+        const auto [first, last] = pieces(t);
+        for (auto piece = first; piece != last; ++piece)
+          for (int k = 0; k < 3; ++k) {
+            const int e = (k + 1) % 3;
+            const auto line = line_through(piece->x[k] / m, piece->y[k] / m, piece->x[e] / m, piece->y[e] / m);
+            // A line crosses the unit square when the centre is within half its extent along the normal.
+            if (line && std::abs(line->side(j + 0.5, i + 0.5)) < 0.5 * (std::abs(line->a) + std::abs(line->b)))
+              candidates.push_back({*line, d});
+          }
+      }
+      if (candidates.empty()) continue;
+      std::stable_sort(candidates.begin(), candidates.end(),
+                       [](const BspCandidate& x, const BspCandidate& y) { return x.priority < y.priority; });
+
+      std::vector<BspSample> samples(window.size());
+      for (size_t s = 0; s < window.size(); ++s) {
+        samples[s].x = (window[s].sx + 0.5) / m;
+        samples[s].y = (window[s].sy + 0.5) / m;
+        samples[s].surface = label[s];
+        samples[s].own = window[s].own;
+      }
+      // The tree's shape does not depend on colour: shade only the samples of pixels that get one.
+      if (!build_pixel_bsp(samples, candidates, settings.depth)) continue;
+      for (size_t s = 0; s < window.size(); ++s) {
+        const float cx = static_cast<float>(window[s].sx) + 0.5f, cy = static_cast<float>(window[s].sy) + 0.5f;
+        Vec3 linear;
+        if (tri[s] >= 0) {
+          const ScreenTriangle& st = ctx.triangles[ctx.visibility.screen_index[static_cast<size_t>(window[s].sy) * W2 + window[s].sx]];
+          linear = shade_surface(ctx, g, *shader_, st, g.material_of(st.triangle), cx, cy).linear;
+        } else {
+          linear = sky_color(scene.sky, pixel_ray(ctx.camera, cx, cy));
+        }
+        samples[s].color = {encode_srgb(linear.x), encode_srgb(linear.y), encode_srgb(linear.z)};
+      }
+      rows[i].emplace_back(i * width + j, std::move(*build_pixel_bsp(samples, candidates, settings.depth)));
+    }
+  });
+  BspBorderImage out(width, height, settings.depth);
+  for (auto& row : rows)
+    for (auto& [pixel, tree] : row) out.add(pixel, std::move(tree));
+  return out;
 }
 
 }  // namespace cgsr

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "render_data/bsp_border_builder.h"
 #include "render_data/camera.h"
 #include "render_data/edges.h"
 #include "render_data/gbuffer.h"
@@ -36,6 +37,16 @@ class SceneRenderer {
   // frame (motion vectors reproject each pixel's world point into it; pass `pose` for none).
   GBuffer render(const CameraPose& pose, const CameraPose& previous, int width, int height, float near_plane,
                  float far_plane) const;
+
+  // The sub-pixel BSP border image (bsp_border.h) of the same view at width x height: the view is
+  // rasterized again at settings.samples x the size, so every pixel gets samples^2 samples of which
+  // triangle is visible (plus the ring of its neighbours' nearest samples); a pixel whose samples
+  // see more than one surface (different meshes, or triangles of a mesh that meet at a crease or
+  // do not touch) gets a BSP whose candidate lines are the projected edges of the triangles it
+  // sees that cross it, its leaves the mean colour of their samples, each shaded as render()
+  // shades a pixel centre. Deterministic and independent of the thread count (docs/bsp_border.md).
+  BspBorderImage render_bsp_border(const CameraPose& pose, int width, int height, float near_plane, float far_plane,
+                                   const BspBorderSettings& settings) const;
 
   const SceneGeometry& geometry() const { return geometry_; }
   const RenderSettings& settings() const { return settings_; }
