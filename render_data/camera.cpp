@@ -7,8 +7,10 @@ namespace {
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 }
 
-FrameCamera make_frame_camera(const CameraPose& pose, int width, int height, float near_plane, float far_plane) {
+FrameCamera make_frame_camera(const CameraPose& pose, int width, int height, float near_plane, float far_plane,
+                              Vec2 jitter) {
   FrameCamera cam;
+  cam.jitter = jitter;
   cam.pose = pose;
   cam.width = width;
   cam.height = height;
@@ -45,6 +47,10 @@ FrameCamera make_frame_camera(const CameraPose& pose, int width, int height, flo
   p.m[3][2] = -2.0f * far_plane * near_plane / (far_plane - near_plane);
   p.m[2][3] = -1.0f;
   p.m[3][3] = 0.0f;
+  // NDC offset times w (= -z_view): pixel x grows with NDC x, pixel y shrinks with NDC y. Left
+  // untouched without jitter, so unjittered renders keep their bytes.
+  if (jitter.x != 0) p.m[2][0] = -2.0f * jitter.x / static_cast<float>(width);
+  if (jitter.y != 0) p.m[2][1] = 2.0f * jitter.y / static_cast<float>(height);
   cam.projection = p;
   cam.view_projection = p * v;
   cam.focal_px = 0.5f * static_cast<float>(height) * fy;
@@ -60,8 +66,8 @@ bool project_to_pixel(const FrameCamera& cam, Vec3 world, Vec2& pixel, float& vi
 }
 
 Vec3 pixel_ray(const FrameCamera& cam, float x, float y) {
-  const float u = (x - 0.5f * cam.width) / cam.focal_px;
-  const float v = (0.5f * cam.height - y) / cam.focal_px;
+  const float u = (x - cam.jitter.x - 0.5f * cam.width) / cam.focal_px;
+  const float v = (0.5f * cam.height - (y - cam.jitter.y)) / cam.focal_px;
   return cam.forward + cam.right * u + cam.up * v;
 }
 

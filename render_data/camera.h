@@ -24,9 +24,13 @@ struct FrameCamera {
   Mat4 view_projection;  // world -> clip
   Vec3 right, up, forward;  // world-space camera axes
   float focal_px = 0;       // focal length in pixels (same horizontally and vertically)
+  Vec2 jitter{0, 0};        // sub-pixel offset of the projection (jitter.h): content moves by it
 };
 
-FrameCamera make_frame_camera(const CameraPose& pose, int width, int height, float near_plane, float far_plane);
+// `jitter`: pixels the projection moves every point by (jitter.h), in the projection matrix so
+// rasterization, the G-buffer and pixel_ray all see it.
+FrameCamera make_frame_camera(const CameraPose& pose, int width, int height, float near_plane, float far_plane,
+                              Vec2 jitter = {0, 0});
 
 // Clip space -> pixel coordinates (x right, y down). Requires clip.w > 0.
 inline Vec2 clip_to_pixel(const FrameCamera& cam, Vec4 clip) {

@@ -5,6 +5,8 @@
 
 #include <torch/types.h>
 
+#include <cstdint>
+
 namespace cgsr {
 
 struct GBuffer {
@@ -17,6 +19,9 @@ struct GBuffer {
   torch::Tensor material_id;   // int32 [1,H,W], Mesh::material; -1 on sky
   torch::Tensor edge;          // float32 [1,H,W], 0 or 1 (edges.h)
   torch::Tensor motion;        // float32 [2,H,W], (dx, dy) pixels: the pixel was at p + motion before
+  // Pixels whose point was not in front of the previous camera's near plane: no previous pixel,
+  // so their motion is 0 (render_channels.h). Not stored in the data set; the render reports it.
+  int64_t motion_rejected = 0;
 };
 
 }  // namespace cgsr

@@ -14,7 +14,13 @@
 //                                 0 deg -> 0, 90 deg -> 1 (as in the CGSR data release); 0 for sky
 //   edge            1    {0,1}    object edges (depth discontinuities, id changes, normal creases)
 //   motion          2    pixels   screen-space motion to the previous frame, (dx, dy) in pixels of
-//                                 this resolution: a pixel at p was at p + motion in the previous frame
+//                                 this resolution: a pixel at p was at p + motion in the previous frame.
+//                                 A point that was not in front of the previous camera's near plane
+//                                 (the sky: the far plane) has no previous pixel: motion 0 (its
+//                                 projection would diverge); the render counts those pixels.
+//                                 Motion excludes the sub-pixel jitter (jitter.h, the FSR 2
+//                                 convention): both positions are the unjittered ones, so a still
+//                                 camera over a static scene has motion 0 although the samples move
 
 #include <torch/types.h>
 

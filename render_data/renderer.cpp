@@ -5,6 +5,7 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -34,11 +35,17 @@ struct RenderContext {
 };
 
 // Motion to the previous frame for a world point (w = 1) or a direction (w = 0, sky):
-// previous pixel position minus the current pixel centre; 0 when the point is behind the
-// previous camera.
-Vec2 motion_of(const FrameCamera& previous, Vec4 world, float cx, float cy) {
+// previous pixel position minus the current pixel centre, both unjittered (cx, cy: the centre
+// less the current jitter; `previous` has none), so motion excludes the jitter (render_channels.h). A point that was not in front of the
+// previous camera's near plane has no previous pixel (its projection diverges as its view depth
+// goes to 0, to millions of pixels): motion 0 and `rejected`. The sky counts as at the far plane.
+Vec2 motion_of(const FrameCamera& previous, Vec4 world, float cx, float cy, bool& rejected) {
   const Vec4 c = previous.view_projection * world;
-  if (!(c.w > 1e-6f)) return {0, 0};
+  const float min_w = world.w != 0 ? previous.near_plane
+                                   : previous.near_plane / previous.far_plane *
+                                         std::sqrt(world.x * world.x + world.y * world.y + world.z * world.z);
+  rejected = !(c.w >= min_w && c.w > 0);
+  if (rejected) return {0, 0};
   const Vec2 p = clip_to_pixel(previous, c);
   return {p.x - cx, p.y - cy};
 }
@@ -130,14 +137,16 @@ struct GBufferPlanes {
 
 // No geometry (or a sky surface) at pixel p: the sky at infinity, moving with camera rotation
 // only. Returns its linear colour.
-Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlanes& px, size_t p, float cx, float cy) {
+Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlanes& px, size_t p, float cx, float cy,
+                 bool& rejected) {
   const Vec3 ray = pixel_ray(ctx.camera, cx, cy);
   const Vec3 linear = sky_color(scene.sky, ray);
   px.depth[p] = std::numeric_limits<float>::infinity();
   for (int c = 0; c < 3; ++c) px.normal[c * px.plane + p] = 0;
   px.angle[p] = 0;
   px.object[p] = px.material[p] = -1;
-  const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx, cy);
+  const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx - ctx.camera.jitter.x,
+                           cy - ctx.camera.jitter.y, rejected);
   px.motion[p] = m.x;
   px.motion[px.plane + p] = m.y;
   return linear;
@@ -192,7 +201,7 @@ ShadedPoint shade_surface(const RenderContext& ctx, const SceneGeometry& g, cons
 // normal and angle, ids and motion written.
 Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
                      const ScreenTriangle& tri, const Material& mat, const GBufferPlanes& px, size_t p, float cx,
-                     float cy) {
+                     float cy, bool& rejected) {
   const FrameCamera& cam = ctx.camera;
   const ShadedPoint shaded = shade_surface(ctx, g, shader, tri, mat, cx, cy);
   const Vec3 world = shaded.world, n = shaded.normal;
@@ -210,7 +219,8 @@ Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const Sur
   const Mesh& mesh = g.mesh_of(tri.triangle);
   px.object[p] = mesh.object_id;
   px.material[p] = mesh.material;
-  const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx, cy);
+  const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx - ctx.camera.jitter.x,
+                           cy - ctx.camera.jitter.y, rejected);
   px.motion[p] = m.x;
   px.motion[px.plane + p] = m.y;
   return linear;
@@ -219,12 +229,12 @@ Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const Sur
 }  // namespace
 
 GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous, int width, int height,
-                              float near_plane, float far_plane) const {
+                              float near_plane, float far_plane, Vec2 jitter) const {
   if (width <= 0) throw Error("render", "image width " + config::out_of_range(width, 1, config::kUnbounded));
   if (height <= 0) throw Error("render", "image height " + config::out_of_range(height, 1, config::kUnbounded));
   RenderContext ctx;
-  ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane);
-  ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);
+  ctx.camera = make_frame_camera(pose, width, height, near_plane, far_plane, jitter);
+  ctx.previous = make_frame_camera(previous, width, height, near_plane, far_plane);  // motion excludes jitter
   const SceneGeometry& g = geometry_;
   transform_vertices(g, ctx);
   rasterize_geometry(g, near_plane, width, height, settings_.tile_size, ctx);
@@ -233,7 +243,9 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
   GBuffer& out = ctx.target;
   const GBufferPlanes px(out, width, height);
   const int ts = settings_.tile_size;
+  std::atomic<int64_t> rejected_total{0};
   tbb::parallel_for(tbb::blocked_range2d<int>(0, height, ts, 0, width, ts), [&](const tbb::blocked_range2d<int>& r) {
+    int64_t rejected_here = 0;
     for (int i = r.rows().begin(); i < r.rows().end(); ++i)
       for (int j = r.cols().begin(); j < r.cols().end(); ++j) {
         const size_t p = static_cast<size_t>(i) * width + j;
@@ -241,13 +253,17 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
         const int32_t si = ctx.visibility.screen_index[p];
         const ScreenTriangle* tri = si >= 0 ? &ctx.triangles[si] : nullptr;
         const Material* mat = tri ? &g.material_of(tri->triangle) : nullptr;
-        const Vec3 linear = !tri || mat->sky ? resolve_sky(ctx, g.scene(), px, p, cx, cy)
-                                             : resolve_surface(ctx, g, *shader_, *tri, *mat, px, p, cx, cy);
+        bool rejected = false;
+        const Vec3 linear = !tri || mat->sky ? resolve_sky(ctx, g.scene(), px, p, cx, cy, rejected)
+                                             : resolve_surface(ctx, g, *shader_, *tri, *mat, px, p, cx, cy, rejected);
+        rejected_here += rejected;
         px.color[p] = encode_srgb(linear.x);
         px.color[px.plane + p] = encode_srgb(linear.y);
         px.color[2 * px.plane + p] = encode_srgb(linear.z);
       }
+    rejected_total += rejected_here;
   });
+  out.motion_rejected = rejected_total.load();
 
   out.edge = detect_edges(out.depth, out.normal, out.object_id, settings_.edges);
   return std::move(out);

@@ -35,8 +35,10 @@ class SceneRenderer {
 
   // Renders the view from `pose` at width x height. `previous` is the camera of the previous
   // frame (motion vectors reproject each pixel's world point into it; pass `pose` for none).
+  // `jitter`: the sub-pixel offset of this frame's projection in pixels (jitter.h); the motion
+  // vectors exclude it (a still camera over a static scene has motion 0 whatever the jitter).
   GBuffer render(const CameraPose& pose, const CameraPose& previous, int width, int height, float near_plane,
-                 float far_plane) const;
+                 float far_plane, Vec2 jitter = {0, 0}) const;
 
   // The sub-pixel BSP border image (bsp_border.h) of the same view at width x height: the view is
   // rasterized again at settings.samples x the size, so every pixel gets samples^2 samples of which

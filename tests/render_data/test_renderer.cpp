@@ -5,10 +5,13 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 
 #include "render_data/camera.h"
 #include "render_data/render_channels.h"
 #include "render_data/renderer.h"
+#include "render_data/scene_source.h"
 #include "test_scenes.h"
 
 namespace cgsr {
@@ -172,6 +175,82 @@ TEST(Renderer, MotionVectorsOfACameraTranslation) {
       EXPECT_NEAR(m[0][i][j], mx, 1e-3f);
       EXPECT_NEAR(m[1][i][j], my, 1e-3f);
     }
+}
+
+// The camera moved back since the previous frame: the floor just in front of it now was behind
+// (or within the near plane of) the previous camera. Those pixels have no previous pixel: motion
+// 0 and counted; before the near-plane test, points just in front of the previous camera's plane
+// got motions of millions of pixels.
+TEST(Renderer, PointsBehindThePreviousCamerasNearPlaneHaveZeroMotionAndAreCounted) {
+  Scene s = test::empty_scene();
+  test::add_quad(s, {0, -1, -50}, {50, 0, 0}, {0, 0, -50}, 1);  // floor y = -1, z in [-100, 0]
+  SceneRenderer r(s, no_shadows());
+  CameraPose now = looking_down_minus_z(60);
+  now.pitch = -30;
+  CameraPose before = now;
+  before.position = {0, 0, -3};
+  const float near_plane = 0.1f, far_plane = 200.0f;
+  const int W = 64, H = 48;
+  const GBuffer g = r.render(now, before, W, H, near_plane, far_plane);
+  const FrameCamera cam = make_frame_camera(now, W, H, near_plane, far_plane);
+  const FrameCamera prev = make_frame_camera(before, W, H, near_plane, far_plane);
+  auto d = g.depth.accessor<float, 3>();
+  auto m = g.motion.accessor<float, 3>();
+  int behind = 0, unsure = 0, in_front = 0;
+  for (int i = 0; i < H; ++i)
+    for (int j = 0; j < W; ++j) {
+      if (!std::isfinite(d[0][i][j])) continue;
+      const Vec3 world = cam.pose.position + pixel_ray(cam, j + 0.5f, i + 0.5f) * d[0][i][j];
+      const float w = dot(world - prev.pose.position, prev.forward);  // view depth in the previous camera
+      ASSERT_TRUE(std::isfinite(m[0][i][j]) && std::isfinite(m[1][i][j])) << i << "," << j;
+      if (w < near_plane - 1e-3f) {
+        ++behind;
+        EXPECT_EQ(m[0][i][j], 0.0f) << i << "," << j << " w " << w;
+        EXPECT_EQ(m[1][i][j], 0.0f) << i << "," << j << " w " << w;
+      } else if (w > near_plane + 1e-3f) {
+        ++in_front;
+        Vec2 p;
+        float depth;
+        ASSERT_TRUE(project_to_pixel(prev, world, p, depth));
+        const float tol = 1e-3f * std::max(1.0f, std::abs(p.x - j - 0.5f) + std::abs(p.y - i - 0.5f));
+        EXPECT_NEAR(m[0][i][j], p.x - (j + 0.5f), tol) << i << "," << j;
+        EXPECT_NEAR(m[1][i][j], p.y - (i + 0.5f), tol) << i << "," << j;
+      } else {
+        ++unsure;
+      }
+    }
+  ASSERT_GT(behind, W);  // the scene does put points behind the previous camera
+  ASSERT_GT(in_front, W);
+  EXPECT_GE(g.motion_rejected, behind);
+  EXPECT_LE(g.motion_rejected, behind + unsure);
+}
+
+// A still camera rejects nothing; the sky of a turning camera is at the far plane, in front.
+TEST(Renderer, NoPixelIsRejectedWhenEveryPointWasInFrontOfThePreviousCamera) {
+  Scene s = test::empty_scene();
+  test::add_quad(s, {0, 0, -4}, {2, 0, 0}, {0, 2, 0}, 1);
+  SceneRenderer r(s, no_shadows());
+  CameraPose now = looking_down_minus_z(60), before = now;
+  EXPECT_EQ(r.render(now, before, 32, 24, 0.1f, 100.0f).motion_rejected, 0);
+  now.yaw = 3;
+  now.position = {0.1f, 0, 0};
+  EXPECT_EQ(r.render(now, before, 32, 24, 0.1f, 100.0f).motion_rejected, 0);
+}
+
+// Along a whole camera path through a room with props (walls and props pass close to the camera),
+// every motion vector is finite and within a few image widths.
+TEST(Renderer, MotionAlongACameraPathStaysWithinAFewImageWidths) {
+  const auto doc = config::Document::load_file(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/default.yaml");
+  const config::Block block{doc.root()["scene"], std::make_shared<config::Document>(doc), "scene"};
+  const SceneBundle b = make_scene(block, 1);
+  const SceneRenderer r(b.scene, no_shadows());
+  const int W = 64, H = 48, frames = 96;
+  for (int f = 0; f < frames; f += 3) {
+    const GBuffer g = r.render(b.camera.at_frame(f, frames), b.camera.at_frame(f - 1, frames), W, H,
+                               b.camera.near_plane, b.camera.far_plane);
+    ASSERT_TRUE(torch::isfinite(g.motion).all().item<bool>()) << "frame " << f;
+    EXPECT_LT(g.motion.abs().max().item<float>(), 3.0f * W) << "frame " << f;
+  }
 }
 
 TEST(Renderer, SkyHasInfiniteDepthAndRotationalMotion) {
