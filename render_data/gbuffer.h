@@ -22,6 +22,9 @@ struct GBuffer {
   // Pixels whose point was not in front of the previous camera's near plane: no previous pixel,
   // so their motion is 0 (render_channels.h). Not stored in the data set; the render reports it.
   int64_t motion_rejected = 0;
+  // Pixels whose previous position lay beyond the guard band one image size around the previous
+  // frame: their motion is cut there, keeping its direction (render_channels.h).
+  int64_t motion_clamped = 0;
 };
 
 }  // namespace cgsr

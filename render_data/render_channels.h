@@ -18,6 +18,9 @@
 //                                 A point that was not in front of the previous camera's near plane
 //                                 (the sky: the far plane) has no previous pixel: motion 0 (its
 //                                 projection would diverge); the render counts those pixels.
+//                                 A previous position beyond one image size outside the frame is
+//                                 cut there along the motion (still outside: no history), so
+//                                 |motion| stays within two image sizes per axis; also counted.
 //                                 Motion excludes the sub-pixel jitter (jitter.h, the FSR 2
 //                                 convention): both positions are the unjittered ones, so a still
 //                                 camera over a static scene has motion 0 although the samples move

@@ -34,20 +34,36 @@ struct RenderContext {
   GBuffer target;
 };
 
+// How a pixel's motion came out: as projected, clamped to the guard band, or rejected.
+enum class MotionStatus { Exact, Clamped, Rejected };
+
 // Motion to the previous frame for a world point (w = 1) or a direction (w = 0, sky):
 // previous pixel position minus the current pixel centre, both unjittered (cx, cy: the centre
-// less the current jitter; `previous` has none), so motion excludes the jitter (render_channels.h). A point that was not in front of the
-// previous camera's near plane has no previous pixel (its projection diverges as its view depth
-// goes to 0, to millions of pixels): motion 0 and `rejected`. The sky counts as at the far plane.
-Vec2 motion_of(const FrameCamera& previous, Vec4 world, float cx, float cy, bool& rejected) {
+// less the current jitter; `previous` has none), so motion excludes the jitter (render_channels.h).
+// A point that was not in front of the previous camera's near plane has no previous pixel (its
+// projection diverges as its view depth goes to 0, to millions of pixels): motion 0, Rejected.
+// The sky counts as at the far plane. A point in front of it but far outside the previous view
+// (beside the camera after a fast turn) keeps its direction, cut at the guard band one image
+// size around the previous frame: still outside, so a consumer still sees no history there.
+Vec2 motion_of(const FrameCamera& previous, Vec4 world, float cx, float cy, MotionStatus& status) {
   const Vec4 c = previous.view_projection * world;
   const float min_w = world.w != 0 ? previous.near_plane
                                    : previous.near_plane / previous.far_plane *
                                          std::sqrt(world.x * world.x + world.y * world.y + world.z * world.z);
-  rejected = !(c.w >= min_w && c.w > 0);
-  if (rejected) return {0, 0};
+  if (!(c.w >= min_w && c.w > 0)) {
+    status = MotionStatus::Rejected;
+    return {0, 0};
+  }
   const Vec2 p = clip_to_pixel(previous, c);
-  return {p.x - cx, p.y - cy};
+  Vec2 m{p.x - cx, p.y - cy};
+  const float w = static_cast<float>(previous.width), h = static_cast<float>(previous.height);
+  float t = 1;  // the largest t <= 1 with (cx, cy) + t * m inside [-w, 2w] x [-h, 2h]
+  if (m.x > 0) t = std::min(t, (2 * w - cx) / m.x);
+  if (m.x < 0) t = std::min(t, (-w - cx) / m.x);
+  if (m.y > 0) t = std::min(t, (2 * h - cy) / m.y);
+  if (m.y < 0) t = std::min(t, (-h - cy) / m.y);
+  status = t < 1 ? MotionStatus::Clamped : MotionStatus::Exact;
+  return t < 1 ? m * t : m;
 }
 
 }  // namespace
@@ -138,7 +154,7 @@ struct GBufferPlanes {
 // No geometry (or a sky surface) at pixel p: the sky at infinity, moving with camera rotation
 // only. Returns its linear colour.
 Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlanes& px, size_t p, float cx, float cy,
-                 bool& rejected) {
+                 MotionStatus& motion) {
   const Vec3 ray = pixel_ray(ctx.camera, cx, cy);
   const Vec3 linear = sky_color(scene.sky, ray);
   px.depth[p] = std::numeric_limits<float>::infinity();
@@ -146,7 +162,7 @@ Vec3 resolve_sky(const RenderContext& ctx, const Scene& scene, const GBufferPlan
   px.angle[p] = 0;
   px.object[p] = px.material[p] = -1;
   const Vec2 m = motion_of(ctx.previous, Vec4{ray.x, ray.y, ray.z, 0}, cx - ctx.camera.jitter.x,
-                           cy - ctx.camera.jitter.y, rejected);
+                           cy - ctx.camera.jitter.y, motion);
   px.motion[p] = m.x;
   px.motion[px.plane + p] = m.y;
   return linear;
@@ -201,7 +217,7 @@ ShadedPoint shade_surface(const RenderContext& ctx, const SceneGeometry& g, cons
 // normal and angle, ids and motion written.
 Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const SurfaceShader& shader,
                      const ScreenTriangle& tri, const Material& mat, const GBufferPlanes& px, size_t p, float cx,
-                     float cy, bool& rejected) {
+                     float cy, MotionStatus& motion) {
   const FrameCamera& cam = ctx.camera;
   const ShadedPoint shaded = shade_surface(ctx, g, shader, tri, mat, cx, cy);
   const Vec3 world = shaded.world, n = shaded.normal;
@@ -220,7 +236,7 @@ Vec3 resolve_surface(const RenderContext& ctx, const SceneGeometry& g, const Sur
   px.object[p] = mesh.object_id;
   px.material[p] = mesh.material;
   const Vec2 m = motion_of(ctx.previous, Vec4{world.x, world.y, world.z, 1}, cx - ctx.camera.jitter.x,
-                           cy - ctx.camera.jitter.y, rejected);
+                           cy - ctx.camera.jitter.y, motion);
   px.motion[p] = m.x;
   px.motion[px.plane + p] = m.y;
   return linear;
@@ -243,9 +259,9 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
   GBuffer& out = ctx.target;
   const GBufferPlanes px(out, width, height);
   const int ts = settings_.tile_size;
-  std::atomic<int64_t> rejected_total{0};
+  std::atomic<int64_t> rejected_total{0}, clamped_total{0};
   tbb::parallel_for(tbb::blocked_range2d<int>(0, height, ts, 0, width, ts), [&](const tbb::blocked_range2d<int>& r) {
-    int64_t rejected_here = 0;
+    int64_t rejected_here = 0, clamped_here = 0;
     for (int i = r.rows().begin(); i < r.rows().end(); ++i)
       for (int j = r.cols().begin(); j < r.cols().end(); ++j) {
         const size_t p = static_cast<size_t>(i) * width + j;
@@ -253,17 +269,20 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
         const int32_t si = ctx.visibility.screen_index[p];
         const ScreenTriangle* tri = si >= 0 ? &ctx.triangles[si] : nullptr;
         const Material* mat = tri ? &g.material_of(tri->triangle) : nullptr;
-        bool rejected = false;
-        const Vec3 linear = !tri || mat->sky ? resolve_sky(ctx, g.scene(), px, p, cx, cy, rejected)
-                                             : resolve_surface(ctx, g, *shader_, *tri, *mat, px, p, cx, cy, rejected);
-        rejected_here += rejected;
+        MotionStatus motion = MotionStatus::Exact;
+        const Vec3 linear = !tri || mat->sky ? resolve_sky(ctx, g.scene(), px, p, cx, cy, motion)
+                                             : resolve_surface(ctx, g, *shader_, *tri, *mat, px, p, cx, cy, motion);
+        rejected_here += motion == MotionStatus::Rejected;
+        clamped_here += motion == MotionStatus::Clamped;
         px.color[p] = encode_srgb(linear.x);
         px.color[px.plane + p] = encode_srgb(linear.y);
         px.color[2 * px.plane + p] = encode_srgb(linear.z);
       }
     rejected_total += rejected_here;
+    clamped_total += clamped_here;
   });
   out.motion_rejected = rejected_total.load();
+  out.motion_clamped = clamped_total.load();
 
   out.edge = detect_edges(out.depth, out.normal, out.object_id, settings_.edges);
   return std::move(out);
