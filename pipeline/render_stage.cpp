@@ -107,6 +107,19 @@ nlohmann::ordered_json bsp_border_json(const RenderJobResult& r) {
           {"fraction_of_color_png", png > 0 ? r.bsp_border_bytes / png : 0.0}};
 }
 
+// Per resolution, the pixels whose point was behind the previous camera's near plane (motion 0)
+// and those whose motion was cut at the guard band, over the frames rendered in this run.
+nlohmann::ordered_json motion_rejected_json(const RenderJobResult& r) {
+  nlohmann::ordered_json j;
+  j["frames_counted"] = r.rendered;
+  for (size_t i = 0; i < r.motion_rejected.size(); ++i)
+    j[r.manifest.resolutions[i].name()] = {{"pixels", r.motion_rejected[i].pixels},
+                                           {"max_per_frame", r.motion_rejected[i].max_per_frame},
+                                           {"frames", r.motion_rejected[i].frames},
+                                           {"clamped_pixels", r.motion_rejected[i].clamped}};
+  return j;
+}
+
 // What every render reports, of one scene or a set.
 nlohmann::ordered_json render_summary(const std::filesystem::path& out, const DatasetManifest& manifest, int rendered,
                                       int resumed, double seconds) {
@@ -148,7 +161,8 @@ Rendered render_scene_set(const RenderOptions& options, const std::filesystem::p
                            {"rendered", s.rendered},
                            {"resumed", s.skipped},
                            {"triangles", s.triangles},
-                           {"bytes_per_frame", sizes_json(s)}});
+                           {"bytes_per_frame", sizes_json(s)},
+                           {"motion_rejected", motion_rejected_json(s)}});
     if (s.manifest.bsp_border_depth > 0) j["scenes"].back()["bsp_border"] = bsp_border_json(s);
     std::string sizes;
     for (size_t k = 0; k < s.manifest.resolutions.size(); ++k)
@@ -168,6 +182,7 @@ Rendered render_one_scene(const RenderOptions& options, const std::filesystem::p
   nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
   j["triangles"] = r.triangles;
   j["bytes_per_frame"] = sizes_json(r);
+  j["motion_rejected"] = motion_rejected_json(r);
   if (r.manifest.bsp_border_depth > 0) j["bsp_border"] = bsp_border_json(r);
   std::printf("rendered %d frame(s) (%d resumed) of '%s' into %s in %.1f s\n", r.rendered, r.skipped,
               r.manifest.name.c_str(), out.string().c_str(), r.seconds);

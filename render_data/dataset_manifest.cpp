@@ -187,6 +187,15 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
     out << YAML::Key << "encoding" << YAML::Value << "cgsr sub-pixel BSP border file version 1 (docs/bsp_border.md)";
     out << YAML::EndMap;
   }
+  if (!m.jitter_sequence.empty()) {
+    out << YAML::Key << "jitter" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "resolution" << YAML::Value << m.resolutions.front().name();
+    out << YAML::Key << "sequence" << YAML::Value << m.jitter_sequence;
+    out << YAML::Key << "phases" << YAML::Value << m.jitter_phases;
+    out << YAML::Key << "offsets" << YAML::Value << YAML::BeginSeq;
+    for (const auto& o : m.jitter_offsets) out << YAML::Flow << YAML::BeginSeq << o[0] << o[1] << YAML::EndSeq;
+    out << YAML::EndSeq << YAML::EndMap;
+  }
   write_split(out, m.split);
   if (!m.bytes_per_frame.empty()) {
     out << YAML::Key << "bytes_per_frame" << YAML::Value << YAML::BeginMap;
@@ -234,6 +243,36 @@ void read_scenes(const YAML::Node& list, const config::Cursor& at, DatasetManife
   const auto weighted = std::count_if(m.scenes.begin(), m.scenes.end(), [](const ManifestScene& s) { return s.weight > 0; });
   if (weighted != 0 && weighted != static_cast<long>(m.scenes.size()))
     at.fail(list, "give every scene a weight, or none (then scenes are drawn in proportion to their training frames)");
+}
+}  // namespace
+
+namespace {
+// The `jitter` block: offsets of the smallest resolution's frames, one per frame, in [-0.5, 0.5).
+void read_jitter(const YAML::Node& n, const config::Cursor& at, DatasetManifest& m) {
+  if (!n.IsMap()) at.fail(n, "expected a map {resolution, sequence, phases, offsets}, got " + config::detail::describe(n));
+  for (const char* key : {"resolution", "sequence", "phases", "offsets"})
+    if (!n[key]) at.child(key).fail(n, std::string("missing required key '") + key + "'");
+  const auto resolution = config::Codec<std::string>::decode(n["resolution"], at.child("resolution"));
+  if (resolution != m.resolutions.front().name())
+    at.child("resolution").fail(n["resolution"], "is " + resolution + ", but only the smallest resolution, " +
+                                                     m.resolutions.front().name() + ", is jittered");
+  m.jitter_sequence = config::Codec<std::string>::decode(n["sequence"], at.child("sequence"));
+  if (m.jitter_sequence != "halton")
+    at.child("sequence").fail(n["sequence"], "unknown jitter sequence '" + m.jitter_sequence + "' (known: halton)");
+  m.jitter_phases = config::Codec<int>::decode(n["phases"], at.child("phases"));
+  config::detail::require_in_range(m.jitter_phases, 1, 1024, n["phases"], at.child("phases"));
+  const auto offsets = config::Codec<std::vector<std::vector<double>>>::decode(n["offsets"], at.child("offsets"));
+  if (static_cast<int>(offsets.size()) != m.frames)
+    at.child("offsets").fail(n["offsets"], "has " + std::to_string(offsets.size()) + " offsets for " +
+                                               std::to_string(m.frames) + " frames (one [x, y] per frame)");
+  for (size_t f = 0; f < offsets.size(); ++f) {
+    const auto& o = offsets[f];
+    const config::Cursor fat = at.child("offsets").child(std::to_string(f));
+    if (o.size() != 2) fat.fail(n["offsets"][f], "expected [x, y], got " + std::to_string(o.size()) + " numbers");
+    for (double v : o)
+      if (!(v >= -0.5 && v < 0.5)) fat.fail(n["offsets"][f], "offset " + std::to_string(v) + " is outside [-0.5, 0.5) pixels");
+    m.jitter_offsets.push_back({o[0], o[1]});
+  }
 }
 }  // namespace
 
@@ -309,6 +348,7 @@ DatasetManifest read_manifest(const fs::path& root) {
     m.bsp_border_samples = config::Codec<int>::decode(bsp["samples"], bat.child("samples"));
     config::detail::require_in_range(m.bsp_border_samples, 2, 16, bsp["samples"], bat.child("samples"));
   }
+  if (const YAML::Node jitter = n["jitter"]) read_jitter(jitter, at.child("jitter"), m);
   return m;
 }
 

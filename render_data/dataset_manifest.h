@@ -12,6 +12,7 @@
 // scenes' own splits, so every scene contributes to train, val and test. A manifest without
 // scenes (version 1, still written for a single scene) is one scene.
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -77,6 +78,13 @@ struct DatasetManifest {
   // resolution, with the depth and samples per pixel side they were built with; depth 0: none
   // (and no `bsp_border` key, so manifests without them are written as before).
   int bsp_border_depth = 0, bsp_border_samples = 0;
+  // Sub-pixel jitter of the smallest resolution's frames (render_data/jitter.h): the sequence
+  // ("halton"), its phases and every frame's offset in pixels of that resolution, {x, y} each in
+  // [-0.5, 0.5). Empty sequence: not jittered (and no `jitter` key, so manifests without it are
+  // written as before and older ones load as unjittered).
+  std::string jitter_sequence;
+  int jitter_phases = 0;
+  std::vector<std::array<double, 2>> jitter_offsets;  // per frame
   // Multi-scene data sets only (then the frames live in the scenes' directories, and the planes,
   // field of view, seed and sizes are each scene's own).
   std::vector<ManifestScene> scenes;

@@ -57,6 +57,7 @@ Frame crop(const Frame& f, int x, int y, int w, int h) {
   Frame out;
   out.width = w;
   out.height = h;
+  out.jitter = f.jitter;
   const Frame* src = &f;
   for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
                            std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},

@@ -7,6 +7,7 @@
 
 #include <torch/types.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -31,6 +32,11 @@ struct Frame {
   // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are
   // in the whole frame's pixel coordinates.
   std::shared_ptr<const BspBorderImage> bsp_border;
+  // Sub-pixel offset of this frame's projection, pixels of this resolution, each in [-0.5, 0.5):
+  // the image content sits at p + jitter (render_data/jitter.h). {0, 0} when not jittered (every
+  // resolution but the smallest of a jittered cgsr data set, and every capture). An integer crop
+  // keeps it.
+  std::array<double, 2> jitter{0, 0};
 
   bool has(RenderChannel channel) const;
   std::vector<RenderChannel> channels() const;  // present channels, in the fixed order

@@ -194,6 +194,7 @@ Frame read_dataset_frame(const fs::path& root, const DatasetManifest& m, int fra
   Frame f;
   f.width = r.width;
   f.height = r.height;
+  if (res == 0 && !m.jitter_offsets.empty()) f.jitter = m.jitter_offsets.at(static_cast<size_t>(frame));
   // The files decode independently (normals after depth): one task each, so a 1080p frame's
   // PNG and EXR decodes overlap instead of adding up.
   tbb::task_group files;

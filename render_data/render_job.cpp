@@ -69,6 +69,7 @@ std::string render_fingerprint(const RenderJobOptions& o, uint64_t seed) {
   // Only when on: renders without BSP files keep the fingerprints they had before the option.
   if (o.bsp_border.enabled())
     text += "|bsp_border " + std::to_string(o.bsp_border.depth) + " " + std::to_string(o.bsp_border.samples);
+  if (o.jitter.enabled()) text += "|jitter " + o.jitter.sequence + " " + std::to_string(o.jitter.phases);
   return hex_fingerprint(text);
 }
 
@@ -107,6 +108,14 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
     m.bsp_border_depth = o.bsp_border.depth;
     m.bsp_border_samples = o.bsp_border.samples;
   }
+  if (o.jitter.enabled()) {
+    m.jitter_sequence = o.jitter.sequence;
+    m.jitter_phases = o.jitter.phases;
+    for (int f = 0; f < o.frames; ++f) {
+      const Vec2 j = jitter_offset(o.jitter, f);
+      m.jitter_offsets.push_back({j.x, j.y});
+    }
+  }
 
   fs::create_directories(out);
   check_resumable(out, m.fingerprint);
@@ -126,6 +135,7 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   const bool bsp = o.bsp_border.enabled();
   const Resolution& lr = resolutions.front();
   size_t bsp_pixels = 0, bsp_lines = 0;
+  result.motion_rejected.assign(resolutions.size(), {});
   for (int f = 0; f < o.frames; ++f) {
     const fs::path bsp_file = bsp_border_file(out, lr, f);
     if (frame_complete(out, resolutions, f) && (!bsp || fs::exists(bsp_file))) {
@@ -137,9 +147,17 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
       }
     } else {
       const CameraPose pose = bundle.camera.at_frame(f, o.frames), previous = bundle.camera.at_frame(f - 1, o.frames);
-      for (const auto& r : resolutions) {
-        const GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane);
+      for (size_t ri = 0; ri < resolutions.size(); ++ri) {
+        const Resolution& r = resolutions[ri];
+        // Only the smallest resolution is jittered: the others are ground truth.
+        const Vec2 jitter = ri == 0 ? jitter_offset(o.jitter, f) : Vec2{0, 0};
+        const GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane, jitter);
         write_frame_files(out, r, f, g);
+        auto& rejected = result.motion_rejected[ri];
+        rejected.pixels += g.motion_rejected;
+        rejected.max_per_frame = std::max(rejected.max_per_frame, g.motion_rejected);
+        rejected.frames += g.motion_rejected > 0;
+        rejected.clamped += g.motion_clamped;
       }
       // After the frame's images: an existing BSP file marks the frame complete.
       if (bsp) {
@@ -178,6 +196,16 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
       parts += (k ? ", " : "") + file_kind_name(kinds[k]) + " " + human_bytes(result.bytes_per_kind[ri][k]);
     if (bsp && ri == 0) parts += ", bsp_border " + human_bytes(result.bsp_border_bytes);
     spdlog::info("size per frame at {}: {} ({})", resolutions[ri].name(), human_bytes(m.bytes_per_frame[ri]), parts);
+  }
+  for (size_t ri = 0; ri < resolutions.size(); ++ri) {
+    const auto& mr = result.motion_rejected[ri];
+    if (mr.pixels > 0)
+      spdlog::info("motion at {}: {} pixel(s) in {} of {} rendered frame(s) (at most {} in one) were behind the "
+                   "previous camera's near plane: motion 0",
+                   resolutions[ri].name(), mr.pixels, mr.frames, result.rendered, mr.max_per_frame);
+    if (mr.clamped > 0)
+      spdlog::info("motion at {}: {} pixel(s) came from beyond one image size outside the previous frame: cut there",
+                   resolutions[ri].name(), mr.clamped);
   }
   if (bsp) {
     const double raw = 3.0 * lr.width * lr.height;  // the colour image as 8-bit RGB

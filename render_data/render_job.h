@@ -13,6 +13,8 @@
 //   edges: {depth_threshold: 0.08, crease_angle: 40, id_changes: true}
 //   bsp_border: {depth: 2, samples: 4}  # sub-pixel BSP border files at the smallest resolution
 //                                       # (bsp_border.h); depth 0 (the default): none
+//   jitter: {sequence: halton, phases: 8}  # sub-pixel jitter of the smallest resolution's frames
+//                                       # (jitter.h); sequence none (the default): none
 //   scene: {type: procedural, ...}      # scene_source.h
 
 #include <filesystem>
@@ -24,6 +26,7 @@
 #include "render_data/bsp_border_builder.h"
 #include "render_data/dataset_manifest.h"
 #include "render_data/edges.h"
+#include "render_data/jitter.h"
 
 namespace cgsr {
 
@@ -35,6 +38,7 @@ struct RenderJobOptions {
   int shadow_map_size = 1024;
   EdgeSettings edges;
   BspBorderSettings bsp_border;
+  JitterSettings jitter;
   config::Block scene;
 };
 
@@ -59,6 +63,10 @@ void add_render_job_fields(config::Schema<T>& s, bool scene_required = true) {
             "sub-pixel BSP border files at the smallest resolution (depth 0: none)");
   // Off, the resolved config (and so `cgsr run`'s render stage hash) is what it was before the key.
   s.omit_when("bsp_border", [](const T& o) { return !o.bsp_border.enabled(); });
+  s.section("jitter", static_cast<JitterSettings T::*>(&RenderJobOptions::jitter), jitter_settings_schema(),
+            "sub-pixel jitter of the smallest resolution's frames (sequence none: none)");
+  // Off, the resolved config (and the render stage hash) is what it was before the key.
+  s.omit_when("jitter", [](const T& o) { return !o.jitter.enabled(); });
   s.block("scene", static_cast<config::Block T::*>(&RenderJobOptions::scene), "scene source {type: procedural, ...}");
   if (scene_required)
     s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {
@@ -80,6 +88,15 @@ struct RenderJobResult {
   // With BSP border files: their mean bytes per frame, the share of the smallest resolution's
   // pixels that have a tree, and lines per tree (means over the frames).
   double bsp_border_bytes = 0, bsp_border_fraction = 0, bsp_border_lines = 0;
+  // Per resolution: the pixels whose motion was rejected (GBuffer::motion_rejected: their point
+  // was behind the previous camera's near plane), over the frames rendered now (a resumed frame's
+  // count is not stored), the most in one frame and the frames with any; and the pixels whose
+  // motion was cut at the guard band (GBuffer::motion_clamped).
+  struct MotionRejected {
+    int64_t pixels = 0, max_per_frame = 0, clamped = 0;
+    int frames = 0;
+  };
+  std::vector<MotionRejected> motion_rejected;
 };
 
 // Renders into `out` (created if needed). `progress` is called after each frame (done, total).

@@ -4,6 +4,8 @@
 
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "core/image_io.h"
 #include "render_data/dataset_manifest.h"
 #include "test_scenes.h"
@@ -38,6 +40,14 @@ TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
   ASSERT_EQ(m.resolutions.size(), 2u);
   EXPECT_TRUE(fs::exists(out / "config.yaml"));
   EXPECT_TRUE(fs::exists(out / "128x96" / "motion" / "000005.exr"));
+  // Motion rejected behind the previous camera is reported per resolution over the rendered frames.
+  const auto results = nlohmann::json::parse(std::ifstream(out / "results.json"));
+  const auto& rejected = results.at("motion_rejected");
+  EXPECT_EQ(rejected.at("frames_counted"), 6);
+  for (const char* r : {"64x48", "128x96"}) {
+    EXPECT_GE(rejected.at(r).at("pixels").get<int64_t>(), rejected.at(r).at("max_per_frame").get<int64_t>()) << r;
+    EXPECT_LE(rejected.at(r).at("frames").get<int>(), 6) << r;
+  }
 
   const CliResult check = run_cgsr("data check " + out.string());
   ASSERT_EQ(check.exit_code, 0) << check.all();
