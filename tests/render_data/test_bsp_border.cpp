@@ -25,15 +25,6 @@
 namespace cgsr {
 namespace bsp_test {  // named: the tests compile as one unity translation unit
 
-constexpr double kPi = 3.14159265358979;
-
-RenderSettings no_shadows() {
-  RenderSettings s;
-  s.shadows = false;
-  s.tile_size = 8;
-  return s;
-}
-
 // A plane much larger than the view at z = -5 whose left edge runs through the view at `degrees`
 // from the vertical; sky on its left.
 Scene slanted_edge_scene(double degrees) {
@@ -63,7 +54,7 @@ std::vector<std::pair<double, double>> hr_flips(const GBuffer& hr, int scale) {
 TEST(BspBorder, RenderedLineReproducesTheHrEdgeWithinATenthOfAnLrPixel) {
   for (const double degrees : {17.0, -31.0}) {
     SCOPED_TRACE("edge at " + std::to_string(degrees) + " degrees");
-    const SceneRenderer r(slanted_edge_scene(degrees), no_shadows());
+    const SceneRenderer r(slanted_edge_scene(degrees), test::unshadowed());
     CameraPose pose;
     pose.vfov = 60;
     const int W = 64, H = 48, s = 2;
@@ -118,7 +109,7 @@ TEST(BspBorder, RenderedLineReproducesTheHrEdgeWithinATenthOfAnLrPixel) {
 }
 
 TEST(BspBorder, LeavesHoldTheColoursOfEachSide) {
-  const SceneRenderer r(slanted_edge_scene(17), no_shadows());
+  const SceneRenderer r(slanted_edge_scene(17), test::unshadowed());
   CameraPose pose;
   pose.vfov = 60;
   const int W = 64, H = 48;
@@ -150,7 +141,7 @@ TEST(BspBorder, NoBorderInsideOneSurface) {
   // A plane filling the view, made of two triangles: the diagonal between them is no border.
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -5}, {50, 0, 0}, {0, 50, 0}, 3);
-  const SceneRenderer r(s, no_shadows());
+  const SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   const BspBorderImage bsp = r.render_bsp_border(pose, 32, 24, 0.1f, 100.0f, {2, 4});
   EXPECT_EQ(bsp.size(), 0u);
@@ -159,7 +150,7 @@ TEST(BspBorder, NoBorderInsideOneSurface) {
 TEST(BspBorder, RefusesSettingsOutOfRange) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -5}, {50, 0, 0}, {0, 50, 0}, 3);
-  const SceneRenderer r(s, no_shadows());
+  const SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   const auto message = [&](int width, int height, BspBorderSettings settings) {
     try {
@@ -185,7 +176,7 @@ SceneBundle tiny_scene() {
 
 TEST(BspBorder, SameBytesWithOneThreadAndMany) {
   const SceneBundle b = tiny_scene();
-  const SceneRenderer r(b.scene, no_shadows());
+  const SceneRenderer r(b.scene, test::unshadowed());
   const CameraPose pose = b.camera.at_frame(2, 6);
   const float near_plane = b.camera.near_plane, far_plane = b.camera.far_plane;
   const std::string many = encode_bsp_border(r.render_bsp_border(pose, 64, 48, near_plane, far_plane, {2, 4}));

@@ -25,13 +25,6 @@ namespace cgsr {
 namespace {
 namespace fs = std::filesystem;
 
-RenderSettings unshadowed() {
-  RenderSettings s;
-  s.shadows = false;
-  s.tile_size = 8;
-  return s;
-}
-
 JitterSettings halton_jitter(int phases) {
   JitterSettings j;
   j.sequence = "halton";
@@ -84,7 +77,7 @@ TEST(Jitter, OffsetsAreHaltonLessAHalfAndWrapAtThePhases) {
 TEST(Jitter, AJitteredRenderIsTheUnjitteredViewOffsetByTheJitter) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, -1, -500}, {500, 0, 0}, {0, 0, -500}, 1);  // floor y = -1, z in [-1000, 0]
-  SceneRenderer r(s, unshadowed());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   pose.pitch = -20;
   const int W = 40, H = 30;
@@ -113,7 +106,7 @@ TEST(Jitter, AJitteredRenderIsTheUnjitteredViewOffsetByTheJitter) {
 TEST(Jitter, MotionExcludesTheJitter) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0.5f, 0, -4}, {1, 0, 0}, {0, 1, 0}, 1);  // a card, the sky around it
-  SceneRenderer r(s, unshadowed());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   const int W = 32, H = 24;
   const JitterSettings j8 = halton_jitter(8);
@@ -126,7 +119,7 @@ TEST(Jitter, MotionExcludesTheJitter) {
   now.position = {0.3f, -0.1f, 0};
   Scene w = test::empty_scene();
   test::add_quad(w, {0, 0, -4}, {50, 0, 0}, {0, 50, 0}, 2);  // every pixel a surface at depth 4
-  SceneRenderer wall(w, unshadowed());
+  SceneRenderer wall(w, test::unshadowed());
   const GBuffer g = wall.render(now, pose, W, H, 0.1f, 100.0f, {0.37f, -0.21f});
   const FrameCamera cam = make_frame_camera(now, W, H, 0.1f, 100.0f);
   const float mx = cam.focal_px * 0.3f / 4.0f, my = cam.focal_px * 0.1f / 4.0f;
@@ -229,7 +222,7 @@ TEST(Jitter, ARenderedDataSetRecordsTheOffsetsAndTheLoaderReadsThem) {
   }
   // The LR frame is the jittered view: it differs from an unjittered render of the same pose.
   const SceneBundle b = make_scene(job.scene, 1);
-  const SceneRenderer renderer(b.scene, unshadowed());
+  const SceneRenderer renderer(b.scene, test::unshadowed());
   const GBuffer unjittered = renderer.render(b.camera.at_frame(1, 3), b.camera.at_frame(0, 3), 32, 24,
                                              b.camera.near_plane, b.camera.far_plane);
   const GBuffer jittered = renderer.render(b.camera.at_frame(1, 3), b.camera.at_frame(0, 3), 32, 24,

@@ -18,15 +18,6 @@
 namespace cgsr {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
-
-RenderSettings no_shadows() {
-  RenderSettings s;
-  s.shadows = false;
-  s.tile_size = 8;
-  return s;
-}
-
 CameraPose looking_down_minus_z(float vfov = 60) {
   CameraPose p;
   p.vfov = vfov;
@@ -37,7 +28,7 @@ TEST(Renderer, FacingPlaneHasConstantDepthAndNormal) {
   Scene s = test::empty_scene();
   // Plane z = -5, facing +z (the camera), much larger than the view.
   test::add_quad(s, {0, 0, -5}, {50, 0, 0}, {0, 50, 0}, 3);
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   const int W = 40, H = 30;
   const auto pose = looking_down_minus_z(70);
   const GBuffer g = r.render(pose, pose, W, H, 0.1f, 100.0f);
@@ -55,7 +46,7 @@ TEST(Renderer, FacingPlaneHasConstantDepthAndNormal) {
       EXPECT_EQ(id[0][i][j], 3);
       // Angle between the normal (0,0,1) and the direction to the camera through this pixel.
       const double u = (j + 0.5 - W / 2.0) / cam.focal_px, v = (H / 2.0 - (i + 0.5)) / cam.focal_px;
-      const double expected = std::acos(1.0 / std::sqrt(1 + u * u + v * v)) / (kPi / 2);
+      const double expected = std::acos(1.0 / std::sqrt(1 + u * u + v * v)) / (kPiF / 2);
       EXPECT_NEAR(angle[0][i][j], expected, 1e-4);
     }
   EXPECT_LT(g.motion.abs().max().item<float>(), 1e-3f);  // same camera: no motion
@@ -64,7 +55,7 @@ TEST(Renderer, FacingPlaneHasConstantDepthAndNormal) {
 TEST(Renderer, FloorSeenFromAKnownPoseMatchesRayIntersection) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, 0}, {0, 0, 3000}, {3000, 0, 0}, 1);  // floor y = 0 facing up
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   pose.position = {1, 2, 3};
   pose.yaw = 30;
@@ -100,7 +91,7 @@ TEST(Renderer, LowAndHighResolutionAreAlignedByPixelCentres) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -20}, {100, 0, 0}, {0, 100, 0}, 1);        // background wall
   test::add_quad(s, {0.7f, 0.4f, -6}, {0.8f, 0, 0}, {0, 0.6f, 0}, 2);  // small off-centre card
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose pose;
   pose.position = {0.2f, 0.1f, 0};
   pose.yaw = 4;
@@ -161,7 +152,7 @@ TEST(Renderer, LowAndHighResolutionAreAlignedByPixelCentres) {
 TEST(Renderer, MotionVectorsOfACameraTranslation) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -4}, {50, 0, 0}, {0, 50, 0}, 1);
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose now = looking_down_minus_z(60), before = now;
   now.position = {0.3f, -0.1f, 0};  // the camera moved right and down since the previous frame
   const int W = 32, H = 24;
@@ -185,7 +176,7 @@ TEST(Renderer, MotionVectorsOfACameraTranslation) {
 TEST(Renderer, PointsBehindThePreviousCamerasNearPlaneHaveZeroMotionAndAreCounted) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, -1, -50}, {50, 0, 0}, {0, 0, -50}, 1);  // floor y = -1, z in [-100, 0]
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose now = looking_down_minus_z(60);
   now.pitch = -30;
   CameraPose before = now;
@@ -232,7 +223,7 @@ TEST(Renderer, PointsBehindThePreviousCamerasNearPlaneHaveZeroMotionAndAreCounte
 TEST(Renderer, NoPixelIsRejectedWhenEveryPointWasInFrontOfThePreviousCamera) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -4}, {2, 0, 0}, {0, 2, 0}, 1);
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose now = looking_down_minus_z(60), before = now;
   EXPECT_EQ(r.render(now, before, 32, 24, 0.1f, 100.0f).motion_rejected, 0);
   now.yaw = 3;
@@ -245,7 +236,7 @@ TEST(Renderer, NoPixelIsRejectedWhenEveryPointWasInFrontOfThePreviousCamera) {
 TEST(Renderer, MotionFromFarOutsideThePreviousViewIsCutAtTheGuardBand) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -4}, {50, 0, 0}, {0, 50, 0}, 1);
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose now = looking_down_minus_z(40), before = now;
   before.yaw = 65;
   const float near_plane = 0.1f, far_plane = 100.0f;
@@ -296,7 +287,7 @@ TEST(Renderer, MotionAlongACameraPathStaysWithinAFewImageWidths) {
     const config::Block block{doc.root()["scene"], std::make_shared<config::Document>(doc), "scene"};
     const SceneBundle b = make_scene(block, static_cast<uint64_t>(seed));
     const int frames = doc.root()["frames"].as<int>();
-    const SceneRenderer r(b.scene, no_shadows());
+    const SceneRenderer r(b.scene, test::unshadowed());
     const int W = 64, H = 48;
     int64_t rejected = 0, clamped = 0;
     for (int f = 0; f < frames; f += step) {
@@ -317,7 +308,7 @@ TEST(Renderer, MotionAlongACameraPathStaysWithinAFewImageWidths) {
 
 TEST(Renderer, SkyHasInfiniteDepthAndRotationalMotion) {
   Scene s = test::empty_scene();
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose now = looking_down_minus_z(60), before = now;
   now.yaw = 2;  // turned left: the world (and the sky) moves right on screen, so it was left before
   const GBuffer g = r.render(now, before, 16, 12, 0.1f, 100.0f);
@@ -334,7 +325,7 @@ TEST(Renderer, ExtremeDepthRange) {
   Scene s = test::empty_scene();
   test::add_quad(s, {0, 0, -1e5f}, {1e6f, 0, 0}, {0, 1e6f, 0}, 1);           // very far wall
   test::add_quad(s, {0, 0, -2e-3f}, {1e-4f, 0, 0}, {0, 1e-4f, 0}, 2);        // tiny card at 2 mm
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   const auto pose = looking_down_minus_z(60);
   const int W = 32, H = 24;
   const GBuffer g = r.render(pose, pose, W, H, 1e-3f, 1e6f);
@@ -370,7 +361,7 @@ TEST(Renderer, TexturedSurfacesUseMipmapsAtADistance) {
   m.uvs = {{0, 0}, {25, 0}, {25, 100}, {0, 100}};
   m.indices = {0, 1, 2, 0, 2, 3};
   s.meshes.push_back(m);
-  SceneRenderer r(s, no_shadows());
+  SceneRenderer r(s, test::unshadowed());
   CameraPose pose = looking_down_minus_z(60);
   pose.position = {0, 1, 0};
   const GBuffer g = r.render(pose, pose, 64, 48, 0.1f, 1000.0f);
@@ -394,9 +385,9 @@ TEST(Renderer, ShadowMapsDarkenOccludedSurfaces) {
   CameraPose pose;
   pose.position = {0, 6, 0};
   pose.pitch = -45;
-  RenderSettings with = no_shadows();
+  RenderSettings with = test::unshadowed();
   with.shadows = true;
-  const GBuffer lit = SceneRenderer(s, no_shadows()).render(pose, pose, 64, 48, 0.1f, 100.0f);
+  const GBuffer lit = SceneRenderer(s, test::unshadowed()).render(pose, pose, 64, 48, 0.1f, 100.0f);
   const GBuffer shadowed = SceneRenderer(s, with).render(pose, pose, 64, 48, 0.1f, 100.0f);
   // Floor pixels under the roof: project the floor point below the roof centre.
   const FrameCamera cam = make_frame_camera(pose, 64, 48, 0.1f, 100.0f);

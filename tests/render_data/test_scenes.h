@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "render_data/renderer.h"
 #include "render_data/scene.h"
 
 namespace cgsr::test {
@@ -59,6 +60,14 @@ inline std::filesystem::path temp_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// Renderer settings for the small scenes: no shadow maps (their lights need none), small tiles.
+inline RenderSettings unshadowed() {
+  RenderSettings s;
+  s.shadows = false;
+  s.tile_size = 8;
+  return s;
 }
 
 }  // namespace cgsr::test
