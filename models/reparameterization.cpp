@@ -71,7 +71,6 @@ graph::Graph fold_branch_convs(const graph::Graph& graph) {
     return p;
   };
   const auto match = [&](int chain, int other) -> std::optional<Branches> {
-    Branches b;
     const auto squeeze = private_conv(chain, 1, 0);
     if (!squeeze) return std::nullopt;
     const auto spatial = private_conv(ops[*squeeze].inputs[0], 0, 0);
