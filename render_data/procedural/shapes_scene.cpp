@@ -37,8 +37,10 @@ Outline jittered_polygon(ProceduralRng& rng, int sides, float radius, float angl
   Outline o;
   o.points.push_back({0, 0});
   const float start = rng.range(0, kTwoPiF), step = kTwoPiF / static_cast<float>(sides);
-  for (int k = 0; k < sides; ++k)
-    o.points.push_back(polar(radius * rng.range(min_radius, 1.0f), start + k * step + rng.range(-angle_jitter, angle_jitter)));
+  for (int k = 0; k < sides; ++k) {
+    const float r = radius * rng.range(min_radius, 1.0f);  // draws in statement order: same on every compiler
+    o.points.push_back(polar(r, start + k * step + rng.range(-angle_jitter, angle_jitter)));
+  }
   o.fan(1, sides);
   return o;
 }
@@ -82,7 +84,8 @@ Outline stroke(const std::vector<Vec2>& path, float width) {
 Outline bezier_stroke(ProceduralRng& rng, float radius, float width) {
   const float a = rng.range(0, kTwoPiF);
   const Vec2 p0 = polar(radius, a), p2 = polar(radius, a + kPiF);
-  const Vec2 p1 = polar(radius * rng.range(0.3f, 1.0f) * (rng.chance(0.5) ? 1.0f : -1.0f), a + kPiF / 2);
+  const float bend = radius * rng.range(0.3f, 1.0f);
+  const Vec2 p1 = polar(rng.chance(0.5) ? bend : -bend, a + kPiF / 2);
   std::vector<Vec2> path;
   for (int k = 0; k <= kCurveSegments; ++k) {
     const float t = static_cast<float>(k) / kCurveSegments;
@@ -100,7 +103,10 @@ Outline make_outline(ShapeKind kind, ProceduralRng& rng, const ShapesOptions& o)
     case ShapeKind::Triangle: return jittered_polygon(rng, 3, radius, 0.5f, 0.6f);
     case ShapeKind::Quad: return jittered_polygon(rng, 4, radius, 0.35f, 0.6f);
     case ShapeKind::Disc: return regular_polygon(radius, kRoundSegments, 0);
-    case ShapeKind::Polygon: return regular_polygon(radius, rng.between(3, 8), rng.range(0, kTwoPiF));
+    case ShapeKind::Polygon: {
+      const int sides = rng.between(3, 8);
+      return regular_polygon(radius, sides, rng.range(0, kTwoPiF));
+    }
     case ShapeKind::Ring: return ring(radius, radius - std::min(width, 0.7f * radius), rng.range(0, kTwoPiF));
     case ShapeKind::Bar: {
       const float a = rng.range(0, kTwoPiF);
@@ -185,9 +191,11 @@ class ShapesBuilder {
     material.tint = gradient || textured ? Vec3{1, 1, 1} : from;
     if (textured) {
       material.albedo_texture = static_cast<int>(scene_.textures.size());
-      scene_.textures.push_back(make_texture(rng_.pick(texture_kinds_), o_.texture_size, rng_.bits(),
-                                             {rng_.range(0, 1), rng_.range(0, 1), rng_.range(0, 1)},
-                                             {rng_.range(0, 1), rng_.range(0, 1), rng_.range(0, 1)}));
+      const TextureKind kind = rng_.pick(texture_kinds_);
+      const uint64_t texture_seed = rng_.bits();
+      const Vec3 base{rng_.range(0, 1), rng_.range(0, 1), rng_.range(0, 1)};  // sRGB
+      const Vec3 accent{rng_.range(0, 1), rng_.range(0, 1), rng_.range(0, 1)};
+      scene_.textures.push_back(make_texture(kind, o_.texture_size, texture_seed, base, accent));
     }
     for (const Vec2& p : outline.points) {
       const Vec2 world = (centre + p) * scale;
@@ -263,7 +271,8 @@ config::Schema<ShapesOptions> shapes_schema() {
   s.field("size", &ShapesOptions::size, "[lo, hi] shape extent, fraction of the view height")
       .range(0.001, 4)
       .check(is_range<float>, kRangeMessage);
-  s.field("thickness", &ShapesOptions::thickness, "[lo, hi] width of bars, rings and curves, fraction of the view height")
+  s.field("thickness", &ShapesOptions::thickness,
+          "[lo, hi] width of bars, rings and curves, fraction of the view height")
       .range(0.0001, 1)
       .check(is_range<float>, kRangeMessage);
   s.field("depth_range", &ShapesOptions::depth_range, "depth spread of the shapes, fraction of the background distance")
