@@ -1,10 +1,10 @@
 // cgsr's training step alone, the work bench/pytorch_reference.py times in PyTorch: PAN x2 on a
-// batch of random LR patches, the CGSR loss (L2 image term), backward, gradient-norm clipping
-// and an Adam step, in NCHW and in channels-last. Data loading is not in it (`cgsr train`
+// batch of random LR patches, the CGSR loss (L2 image term; --loss l1 or ssim for the others),
+// backward, gradient-norm clipping and an Adam step, in NCHW and in channels-last. Data loading is not in it (`cgsr train`
 // reports the whole stage's patches per second). Prints one JSON object: steps per
 // second and, per layout, the milliseconds of a step spent in each phase.
 //
-//   bench_training_step [--batch 4] [--patch 24] [--steps 60] [--warmup 5] [--threads 2]
+//   bench_training_step [--batch 4] [--patch 24] [--steps 60] [--warmup 5] [--threads 2] [--loss l2]
 #include <torch/torch.h>
 
 #include <chrono>
@@ -27,7 +27,8 @@ struct StepPhases {
   double forward = 0, backward = 0, clip = 0, optimizer = 0;
 };
 
-double steps_per_second(MemoryLayout layout, int batch_size, int patch, int steps, int warmup, StepPhases& phases) {
+double steps_per_second(MemoryLayout layout, int batch_size, int patch, int steps, int warmup, ErrorNorm norm,
+                        StepPhases& phases) {
   seed_everything(0);
   SRNetwork net(default_spec("pan", 2));
   set_parameter_layout(*net, layout);
@@ -39,6 +40,7 @@ double steps_per_second(MemoryLayout layout, int batch_size, int patch, int step
   batch.hr_color = to_layout(torch::rand({batch_size, 3, 2 * patch, 2 * patch}), layout);
   LossOptions loss;
   loss.lambda_geometry = 0;
+  loss.image_norm = norm;
   using Clock = std::chrono::steady_clock;
   const auto seconds_since = [](Clock::time_point& t) {
     const auto now = Clock::now();
@@ -76,27 +78,30 @@ std::string phases_json(const StepPhases& p, int steps) {
 
 int main(int argc, char** argv) {
   int batch = 4, patch = 24, steps = 60, warmup = 5, threads = 2;
+  ErrorNorm norm = ErrorNorm::L2;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     const int value = std::atoi(argv[i + 1]);
-    if (flag == "--batch") batch = value;
+    if (flag == "--loss") norm = enum_from_name<ErrorNorm>(argv[i + 1]);
+    else if (flag == "--batch") batch = value;
     else if (flag == "--patch") patch = value;
     else if (flag == "--steps") steps = value;
     else if (flag == "--warmup") warmup = value;
     else if (flag == "--threads") threads = value;
     else {
-      std::fprintf(stderr, "usage: bench_training_step [--batch N] [--patch N] [--steps N] [--warmup N] [--threads N]\n");
+      std::fprintf(stderr, "usage: bench_training_step [--batch N] [--patch N] [--steps N] [--warmup N] [--threads N] "
+                           "[--loss l2|l1|ssim]\n");
       return 2;
     }
   }
   set_threads(threads);
   StepPhases nchw_phases, nhwc_phases;
-  const double nchw = steps_per_second(MemoryLayout::Nchw, batch, patch, steps, warmup, nchw_phases);
-  const double nhwc = steps_per_second(MemoryLayout::Nhwc, batch, patch, steps, warmup, nhwc_phases);
-  std::printf("{\"threads\": %d, \"batch\": %d, \"patch\": %d, \"steps\": %d, "
+  const double nchw = steps_per_second(MemoryLayout::Nchw, batch, patch, steps, warmup, norm, nchw_phases);
+  const double nhwc = steps_per_second(MemoryLayout::Nhwc, batch, patch, steps, warmup, norm, nhwc_phases);
+  std::printf("{\"threads\": %d, \"loss\": \"%s\", \"batch\": %d, \"patch\": %d, \"steps\": %d, "
               "\"train_steps_per_second\": {\"nchw\": %.3f, \"nhwc\": %.3f}, "
               "\"ms_per_step\": {\"nchw\": %s, \"nhwc\": %s}}\n",
-              threads, batch, patch, steps, nchw, nhwc, phases_json(nchw_phases, steps).c_str(),
+              threads, enum_name(norm).c_str(), batch, patch, steps, nchw, nhwc, phases_json(nchw_phases, steps).c_str(),
               phases_json(nhwc_phases, steps).c_str());
   return 0;
 }

@@ -11,12 +11,12 @@
 #include "core/color.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/ssim_window.h"
 #include "core/tensor_checks.h"
 
 namespace cgsr {
 namespace {
-constexpr int kWindow = 11;
-constexpr double kSigma = 1.5;
+constexpr int kWindow = ssim_window::kSize;
 
 // Validates the pair and returns both as contiguous NCHW, float64 inputs as they are and
 // everything else as float32, after the Y conversion and border crop. Finiteness is checked by
@@ -52,27 +52,13 @@ std::pair<torch::Tensor, torch::Tensor> prepare(const torch::Tensor& output, con
   throw Error(std::string(metric) + " input", "contains NaN or infinite values");
 }
 
-// The normalized 1-D Gaussian; the 11x11 window is its outer product, applied as a column pass
-// and a row pass (22 instead of 121 multiply-adds per pixel and statistic).
-std::array<double, kWindow> gaussian_1d() {
-  std::array<double, kWindow> g{};
-  double sum = 0;
-  for (int k = 0; k < kWindow; ++k) {
-    const double x = k - (kWindow - 1) / 2.0;
-    g[k] = std::exp(-(x * x) / (2 * kSigma * kSigma));
-    sum += g[k];
-  }
-  for (double& v : g) v /= sum;
-  return g;
-}
-
 // Mean SSIM of one plane over its valid region. Output rows are independent: each computes the
 // five Gaussian-weighted local statistics (means, second moments, cross moment) of its 11 input
-// rows in float64, first down the columns, then along the row. Returns NaN for non-finite input.
+// rows in float64, first down the columns, then along the row (the separable window: 22 instead
+// of 121 multiply-adds per pixel and statistic). Returns NaN for non-finite input.
 template <class T>
 double plane_ssim(const T* a, const T* b, int64_t h, int64_t w) {
-  static const std::array<double, kWindow> g = gaussian_1d();
-  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+  static const std::array<double, kWindow> g = ssim_window::gaussian_1d();
   const int64_t out_h = h - kWindow + 1, out_w = w - kWindow + 1;
   return tbb::parallel_reduce(
       tbb::blocked_range<int64_t>(0, out_h), 0.0,
@@ -103,8 +89,7 @@ double plane_ssim(const T* a, const T* b, int64_t h, int64_t w) {
               e_bb += g[k] * sbb[x + k];
               e_ab += g[k] * sab[x + k];
             }
-            const double var_a = e_aa - mu_a * mu_a, var_b = e_bb - mu_b * mu_b, cov = e_ab - mu_a * mu_b;
-            sum += ((2 * mu_a * mu_b + c1) * (2 * cov + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
+            sum += ssim_window::from_moments(mu_a, mu_b, e_aa, e_bb, e_ab);
           }
         }
         return sum;

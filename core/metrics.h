@@ -2,7 +2,8 @@
 // Image quality metrics on batched tensors (NCHW, or CHW for one image), values in [0,1].
 //   PSNR: 10 log10(1 / MSE) on RGB (or BT.601 Y with y_channel); +inf for identical images.
 //   SSIM: Wang et al. 2004 with an 11x11 Gaussian window (sigma 1.5), K1 0.01, K2 0.03, L = 1,
-//         over the valid region (no padding), averaged over channels.
+//         over the valid region (no padding), averaged over channels (ssim_window.h, shared
+//         with the SSIM training loss).
 // Both accumulate in float64 (parallel over rows) and return one value per image. Non-finite
 // input is an error.
 //   Masked PSNR: the same PSNR over the pixels a mask selects, and over the other pixels (e.g.

@@ -1,6 +1,7 @@
 #include "render_data/scene_source.h"
 
 #include "render_data/procedural/procedural_scene.h"
+#include "render_data/procedural/shapes_scene.h"
 #include "render_data/q3/q3_scene_source.h"
 
 namespace cgsr {
@@ -9,6 +10,7 @@ Registry<SceneSourceFactory>& scene_sources() {
   static Registry<SceneSourceFactory> registry = [] {
     Registry<SceneSourceFactory> r("scene source");
     register_procedural_scene_source(r);
+    register_shapes_scene_source(r);
     q3::register_q3_scene_source(r);
     return r;
   }();

@@ -1,7 +1,8 @@
 #pragma once
 // Scene sources by name: a factory takes the {type: Name, ...} block of a render config and a
 // seed and returns the scene with its camera path. The registry fills itself with the built-in
-// sources on first use: "procedural" (procedural_scene.h) and "q3bsp" (q3/q3_scene_source.h).
+// sources on first use: "procedural" (procedural_scene.h), "shapes" (procedural/shapes_scene.h)
+// and "q3bsp" (q3/q3_scene_source.h).
 //
 //   scene:
 //     type: procedural      # the registry key

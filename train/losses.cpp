@@ -2,7 +2,11 @@
 
 #include <torch/torch.h>
 
+#include <array>
+
 #include "core/error.h"
+#include "core/ssim_window.h"
+#include "core/tensor_checks.h"
 #include "models/importance/channel_importance.h"
 
 namespace cgsr {
@@ -20,12 +24,45 @@ config::Schema<LossOptions> loss_schema() {
 }
 
 const std::vector<std::string>& EnumNames<ErrorNorm>::names() {
-  static const std::vector<std::string> names = {"l2", "l1"};
+  static const std::vector<std::string> names = {"l2", "l1", "ssim"};
   return names;
 }
 
 torch::Tensor reconstruction_error(const torch::Tensor& output, const torch::Tensor& target, ErrorNorm norm) {
-  return norm == ErrorNorm::L1 ? torch::l1_loss(output, target) : torch::mse_loss(output, target);
+  switch (norm) {
+    case ErrorNorm::L1: return torch::l1_loss(output, target);
+    case ErrorNorm::Ssim: return ssim_loss(output, target);
+    case ErrorNorm::L2: break;
+  }
+  return torch::mse_loss(output, target);
+}
+
+torch::Tensor ssim_loss(const torch::Tensor& output, const torch::Tensor& target) {
+  constexpr int64_t k = ssim_window::kSize;
+  if (!output.sizes().equals(target.sizes()))
+    throw Error("SSIM loss", "shapes differ: " + shape_string(output) + " vs " + shape_string(target));
+  if (output.dim() != 3 && output.dim() != 4)
+    throw Error("SSIM loss", "expected CHW or NCHW, got shape " + shape_string(output));
+  const auto a = output.dim() == 3 ? output.unsqueeze(0) : output;
+  const auto b = target.dim() == 3 ? target.unsqueeze(0) : target;
+  if (a.size(2) < k || a.size(3) < k)
+    throw Error("SSIM loss", "needs images (training patches) of at least 11x11 pixels, got " +
+                                 std::to_string(a.size(3)) + "x" + std::to_string(a.size(2)));
+  // The five local statistics of every plane as one depthwise convolution: the separable
+  // Gaussian window as a column pass, then a row pass (as the metric does), no padding.
+  static const std::array<double, k> g = ssim_window::gaussian_1d();
+  const auto kernel = torch::tensor(std::vector<double>(g.begin(), g.end()), torch::kFloat64).to(a.scalar_type());
+  const int64_t planes = 5 * a.size(1);
+  const auto stats = torch::cat({a, b, a * a, b * b, a * b}, 1);
+  const auto column = kernel.view({1, 1, k, 1}).repeat({planes, 1, 1, 1});
+  const auto row = kernel.view({1, 1, 1, k}).repeat({planes, 1, 1, 1});
+  const auto depthwise = [planes](const torch::Tensor& x, const torch::Tensor& w) {
+    return torch::conv2d(x, w, torch::Tensor(), torch::IntArrayRef{1, 1}, torch::IntArrayRef{0, 0},
+                         torch::IntArrayRef{1, 1}, planes);
+  };
+  const auto local = depthwise(depthwise(stats, column), row);
+  const auto m = local.chunk(5, 1);
+  return 1 - ssim_window::from_moments(m[0], m[1], m[2], m[3], m[4]).mean();
 }
 
 LossTerms cgsr_loss(const SRNetworkImpl& net, const TrainOutput& output, const Batch& batch,

@@ -1,7 +1,8 @@
 #pragma once
-// The random source of the procedural scenes: one 64-bit Mersenne twister per level, with the
-// few draws the generator needs. Same seed, same draws, on every platform (no std::
-// distributions, whose output is implementation-defined).
+// The random source of the procedural scene sources (procedural levels, random shapes): one
+// 64-bit Mersenne twister per scene, with the few draws the generators need. Same seed, same
+// draws, on every platform (no std:: distributions, whose output is implementation-defined).
+// Also what the sources share around it: the seed of a `variant`, and their [lo, hi] options.
 
 #include <algorithm>
 #include <cstdint>
@@ -26,5 +27,22 @@ class ProceduralRng {
  private:
   std::mt19937_64 engine_;
 };
+
+// The seed of scene `variant` of a render seed: the seed itself for variant 0 (the scene every
+// config made before variants existed), else the two mixed (splitmix64 finalizer).
+inline uint64_t variant_seed(uint64_t seed, int variant) {
+  if (variant == 0) return seed;
+  uint64_t x = seed ^ (0x9E3779B97F4A7C15ULL * static_cast<uint64_t>(variant));
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+// [lo, hi] options a generator draws from: two values, lo <= hi (a config::Schema check).
+template <class V>
+bool is_range(const std::vector<V>& v) {
+  return v.size() == 2 && v[0] <= v[1];
+}
+inline const char* const kRangeMessage = "must be [lo, hi] with lo <= hi";
 
 }  // namespace cgsr

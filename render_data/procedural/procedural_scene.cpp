@@ -874,11 +874,7 @@ config::Schema<ProceduralOptions> procedural_schema() {
 }
 
 uint64_t procedural_level_seed(const ProceduralOptions& options, uint64_t seed) {
-  if (options.variant == 0) return seed;  // the level every config made before variants existed
-  uint64_t x = seed ^ (0x9E3779B97F4A7C15ULL * static_cast<uint64_t>(options.variant));
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
+  return variant_seed(seed, options.variant);
 }
 
 SceneBundle make_procedural_scene(const ProceduralOptions& options, uint64_t seed) {

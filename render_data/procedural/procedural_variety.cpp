@@ -3,17 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render_data/procedural/procedural_rng.h"
 #include "render_data/procedural/procedural_textures.h"
 
 namespace cgsr {
 namespace {
-
-// [lo, hi] ranges: two values, lo <= hi.
-template <class V>
-bool is_range(const std::vector<V>& v) {
-  return v.size() == 2 && v[0] <= v[1];
-}
-const char* kRangeMessage = "must be [lo, hi] with lo <= hi";
 
 int scaled(int count, float factor) { return static_cast<int>(std::lround(count * factor)); }
 

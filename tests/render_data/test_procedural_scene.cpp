@@ -21,29 +21,13 @@ namespace cgsr {
 namespace {
 namespace fs = std::filesystem;
 
-// A render config as `cgsr render` reads it (its run settings included).
-struct SceneConfig : RenderJobOptions {
-  int64_t seed = 0;
-  int threads = 0;
-};
-
-config::Schema<SceneConfig> scene_config_schema() {
-  config::Schema<SceneConfig> s;
-  add_render_job_fields(s);
-  s.field("seed", &SceneConfig::seed, "seed");
-  s.field("threads", &SceneConfig::threads, "threads");
-  return s;
-}
-
-SceneBundle build(const std::string& yaml, uint64_t seed) {
-  const auto doc = config::Document::parse(yaml, "test.yaml");
-  config::Block block{doc.root(), std::make_shared<config::Document>(doc), ""};
-  return make_scene(block, seed);
-}
+using test::build_scene;
+using test::SceneConfig;
+using test::scene_config_schema;
 
 TEST(ProceduralScene, SameSeedSameSceneOtherSeedOtherScene) {
   const std::string yaml = "type: procedural\nlayout: room\nsize: [12, 10]\ntexture_size: 32\n";
-  const auto a = build(yaml, 5), b = build(yaml, 5), c = build(yaml, 6);
+  const auto a = build_scene(yaml, 5), b = build_scene(yaml, 5), c = build_scene(yaml, 6);
   ASSERT_EQ(a.scene.meshes.size(), b.scene.meshes.size());
   for (size_t m = 0; m < a.scene.meshes.size(); ++m) {
     ASSERT_EQ(a.scene.meshes[m].positions.size(), b.scene.meshes[m].positions.size());
@@ -59,7 +43,7 @@ TEST(ProceduralScene, SameSeedSameSceneOtherSeedOtherScene) {
 
 TEST(ProceduralScene, UnknownOptionIsAnErrorWithItsPosition) {
   try {
-    build("type: procedural\nlayuot: room\n", 1);
+    build_scene("type: procedural\nlayuot: room\n", 1);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     const std::string what = e.what();
@@ -69,7 +53,7 @@ TEST(ProceduralScene, UnknownOptionIsAnErrorWithItsPosition) {
 }
 
 TEST(ProceduralScene, TooManyPropsForTheRoomIsAnError) {
-  EXPECT_THROW(build("type: procedural\nsize: [4, 4]\nprops: {crates: 40}\n", 1), Error);
+  EXPECT_THROW(build_scene("type: procedural\nsize: [4, 4]\nprops: {crates: 40}\n", 1), Error);
 }
 
 // The camera must not be inside any prop or wall: check every mesh's bounding box (shrunk a
@@ -112,13 +96,13 @@ TEST(ProceduralScene, EveryShippedSceneConfigBuildsWithAFreeCameraPath) {
 }
 
 TEST(ProceduralScene, LayoutsProduceTheirCharacteristicGeometry) {
-  const auto arena = build("type: procedural\nlayout: arena\nsize: [12, 12]\ntexture_size: 32\n", 3);
+  const auto arena = build_scene("type: procedural\nlayout: arena\nsize: [12, 12]\ntexture_size: 32\n", 3);
   bool has_ceiling = false, has_sun = false;
   for (const auto& m : arena.scene.meshes) has_ceiling |= m.name == "ceiling";
   for (const auto& l : arena.scene.lights) has_sun |= l.type == LightType::Directional;
   EXPECT_FALSE(has_ceiling);
   EXPECT_TRUE(has_sun);
-  const auto corridors = build("type: procedural\nlayout: corridors\nsize: [11, 11]\ntexture_size: 32\n", 3);
+  const auto corridors = build_scene("type: procedural\nlayout: corridors\nsize: [11, 11]\ntexture_size: 32\n", 3);
   expect_camera_in_free_space(corridors, "corridors");
 }
 
@@ -186,8 +170,8 @@ std::set<std::string> families(const Scene& scene) {
 }
 
 TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
-  expect_identical(build(kVariety, 11), build(kVariety, 11));
-  expect_identical(build(kVariety + "variant: 4\n", 11), build(kVariety + "variant: 4\n", 11));
+  expect_identical(build_scene(kVariety, 11), build_scene(kVariety, 11));
+  expect_identical(build_scene(kVariety + "variant: 4\n", 11), build_scene(kVariety + "variant: 4\n", 11));
   // Over 40 seeds every layout, dark and bright, fog on and off; over a dozen, many texture families.
   ProceduralOptions options;
   options.layout = ProceduralLayout::Random;
@@ -202,7 +186,7 @@ TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
     brightest = std::max(brightest, drawn.lighting.ambient);
     foggy += drawn.fog.density > 0;
     if (seed <= 12)
-      for (const auto& f : families(build(kVariety, seed).scene)) all_families.insert(f);
+      for (const auto& f : families(build_scene(kVariety, seed).scene)) all_families.insert(f);
   }
   EXPECT_EQ(layouts.size(), 5u) << join(std::vector<std::string>(layouts.begin(), layouts.end()));
   EXPECT_GE(all_families.size(), 8u) << join(std::vector<std::string>(all_families.begin(), all_families.end()));
@@ -210,10 +194,10 @@ TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
   EXPECT_GT(foggy, 0);
   EXPECT_LT(foggy, 40);
   // A variant is another level of the same seed; variant 0 is the seed's own level.
-  const auto base = build(kVariety, 11), other = build(kVariety + "variant: 1\n", 11);
+  const auto base = build_scene(kVariety, 11), other = build_scene(kVariety + "variant: 1\n", 11);
   EXPECT_TRUE(base.scene.meshes.size() != other.scene.meshes.size() ||
               base.scene.textures[0].data != other.scene.textures[0].data);
-  expect_identical(base, build(kVariety + "variant: 0\n", 11));
+  expect_identical(base, build_scene(kVariety + "variant: 0\n", 11));
 }
 
 TEST(ProceduralVariety, SameSeedRendersBitIdenticalFrames) {
@@ -238,7 +222,7 @@ TEST(ProceduralVariety, EveryLayoutHasAWalkableCameraPath) {
   for (const std::string layout : {"room", "corridors", "hall", "arena", "outdoor"})
     for (uint64_t seed : {1, 2, 3}) {
       SCOPED_TRACE(layout + " seed " + std::to_string(seed));
-      const auto b = build("type: procedural\nlayout: " + layout + "\ntexture_size: 32\nvariety: {size: [6, 12]}\n", seed);
+      const auto b = build_scene("type: procedural\nlayout: " + layout + "\ntexture_size: 32\nvariety: {size: [6, 12]}\n", seed);
       ASSERT_GE(b.camera.keys.size(), 2u);
       EXPECT_GT(length(b.camera.keys.back().pose.position - b.camera.keys.front().pose.position) +
                     length(b.camera.keys[1].pose.position - b.camera.keys[0].pose.position),
@@ -257,14 +241,14 @@ TEST(ProceduralVariety, EveryLayoutHasAWalkableCameraPath) {
       }
     }
   // Without variety, the new layouts build too (fixed materials).
-  expect_camera_in_free_space(build("type: procedural\nlayout: hall\nsize: [10, 9]\nheight: 8\ntexture_size: 32\n", 2), "hall");
-  expect_camera_in_free_space(build("type: procedural\nlayout: outdoor\nsize: [10, 9]\ntexture_size: 32\n", 2), "outdoor");
+  expect_camera_in_free_space(build_scene("type: procedural\nlayout: hall\nsize: [10, 9]\nheight: 8\ntexture_size: 32\n", 2), "hall");
+  expect_camera_in_free_space(build_scene("type: procedural\nlayout: outdoor\nsize: [10, 9]\ntexture_size: 32\n", 2), "outdoor");
 }
 
 TEST(ProceduralVariety, BadRangesAreErrorsNamingTheKey) {
   auto message = [](const std::string& variety) {
     try {
-      build("type: procedural\nlayout: random\nvariety: " + variety + "\n", 1);
+      build_scene("type: procedural\nlayout: random\nvariety: " + variety + "\n", 1);
     } catch (const Error& e) {
       return std::string(e.what());
     }

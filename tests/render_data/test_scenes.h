@@ -7,8 +7,11 @@
 #include <filesystem>
 #include <string>
 
+#include "core/config.h"
+#include "render_data/render_job.h"
 #include "render_data/renderer.h"
 #include "render_data/scene.h"
+#include "render_data/scene_source.h"
 
 namespace cgsr::test {
 
@@ -60,6 +63,27 @@ inline std::filesystem::path temp_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// A render config as `cgsr render` reads it (its run settings included).
+struct SceneConfig : RenderJobOptions {
+  int64_t seed = 0;
+  int threads = 0;
+};
+
+inline config::Schema<SceneConfig> scene_config_schema() {
+  config::Schema<SceneConfig> s;
+  add_render_job_fields(s);
+  s.field("seed", &SceneConfig::seed, "seed");
+  s.field("threads", &SceneConfig::threads, "threads");
+  return s;
+}
+
+// The scene of a {type: ..., ...} block given as YAML text (errors name "test.yaml").
+inline SceneBundle build_scene(const std::string& yaml, uint64_t seed) {
+  const auto doc = config::Document::parse(yaml, "test.yaml");
+  config::Block block{doc.root(), std::make_shared<config::Document>(doc), ""};
+  return make_scene(block, seed);
 }
 
 // Renderer settings for the small scenes: no shadow maps (their lights need none), small tiles.
