@@ -127,7 +127,7 @@ Generated generate(const graph::Graph& graph) {
         const auto centres = [&](const std::string& axis_name, int dim) {
           const std::string d = std::to_string(dim);
           src << "    " << y << "_" << axis_name << " = (torch.arange(" << off << ".size(" << d
-              << ").float() * 2 + 1) / " << r << " / " << source << ".size(" << d << ") - 1\n";
+              << ")).float() * 2 + 1) / " << r << " / " << source << ".size(" << d << ") - 1\n";
         };
         centres("x", 3);
         centres("y", 2);
