@@ -31,6 +31,9 @@
 //   - the 3x3 Gaussian (sigma 1.5) is normalized to sum 1 and zero-padded (the Conv op's
 //     padding): alpha fades at the frame border, where the interpolation takes over
 //
+// Elastic training, the search and pruning narrow conv1 and conv2 like any layer group (the
+// offsets and the fusion are fixed axes); a run of all three on SRPO x2 finished (docs/results/srpo.md).
+//
 // Layer groups: conv1 (16), conv2 (16: the features). The RIT (CG-enhanced SRPO) joins the
 // features at LR (after conv2's ReLU) and, for rit.source hr_fuse, the HR features after the
 // upsampling (group conv2 at factor s). The geometry head reads the HR features. No blocks.
