@@ -15,7 +15,8 @@
 // Parameters: 8,434, the paper's count, at every scale (the paper keeps "the same architecture
 // as the SR factor 2, only changing the upsampling to x3"): conv1 3*16*5*5 + 16 = 1,216,
 // conv2 16*16*5*5 + 16 = 6,416, conv3 16*2*5*5 + 2 = 802. MACs per LR pixel: 1,200 + 6,400 at LR
-// and s*s*800 at HR (x2: 10,800). The fusion's Gaussian is a constant (no parameters).
+// and s*s*800 at HR (x2: 10,800), plus s*s*27 for the fusion's Gaussian, a constant (no
+// parameters).
 //
 // Training is self-supervised on the projection (Sec. 3.1): in train() mode forward() returns
 // the bilinear projection P, the image the paper's loss compares with the HR frame. The fused
