@@ -25,6 +25,11 @@ OnnxBuilder::OnnxBuilder(const std::string& graph_name,
   g_->set_name(graph_name);
 }
 
+void OnnxBuilder::require_opset(int64_t version) {
+  for (auto& opset : *model_.mutable_opset_import())
+    if (opset.domain().empty() && opset.version() < version) opset.set_version(version);
+}
+
 std::string OnnxBuilder::claim(const std::string& name) {
   CGSR_CHECK(used_.insert(name).second, "onnx export: tensor name '" + name + "' used twice");
   return name;
@@ -119,6 +124,14 @@ std::string OnnxBuilder::int64_initializer(const std::string& name, const std::v
   init->set_data_type(onnx::TensorProto::INT64);
   init->add_dims(static_cast<int64_t>(values.size()));
   for (auto v : values) init->add_int64_data(v);
+  return name;
+}
+
+std::string OnnxBuilder::int64_scalar(const std::string& name, int64_t value) {
+  auto* init = g_->add_initializer();
+  init->set_name(claim(name));
+  init->set_data_type(onnx::TensorProto::INT64);
+  init->add_int64_data(value);
   return name;
 }
 

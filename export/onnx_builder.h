@@ -28,6 +28,9 @@ class OnnxBuilder {
 
   onnx::GraphProto& graph() { return *g_; }
 
+  // Raises the default domain's opset to at least `version` (kOnnxOpset unless an op needs more).
+  void require_opset(int64_t version);
+
   // Reserves a tensor name; a name used twice is an internal error.
   std::string claim(const std::string& name);
 
@@ -52,6 +55,7 @@ class OnnxBuilder {
   std::string initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape);
   std::string float_initializer(const std::string& name, const std::vector<float>& values);  // 1-D
   std::string int64_initializer(const std::string& name, const std::vector<int64_t>& values);  // 1-D
+  std::string int64_scalar(const std::string& name, int64_t value);  // 0-D (Gather indices, Range bounds)
   // INT8, UINT8 or INT32 initializer of `shape` from a kChar, kByte or kInt tensor, as stored.
   std::string integer_initializer(const std::string& name, const torch::Tensor& value, const std::vector<int64_t>& shape);
 

@@ -38,6 +38,8 @@ class Writer {
     names_.resize(graph.values.size());
     dequantized_.resize(graph.values.size());
     if (options.int8) int8_convs_ = low_precision_convs(graph);
+    for (const auto& op : graph.ops)
+      if (op.kind == graph::OpKind::Sample) b_.require_opset(kOnnxGridSampleOpset);
   }
 
   std::string build() {
@@ -162,6 +164,20 @@ class Writer {
         attr(node("Concat", op.name, inputs, {out}), "axis", int64_t{1});
         return;
       }
+      case graph::OpKind::Sample: emit_sample(op, in(0), in(1), out); return;
+      case graph::OpKind::AnyAbsAbove: {
+        const std::string magnitude = claim(op.name + ".abs"), largest = claim(op.name + ".max"),
+                          above = claim(op.name + ".above");
+        node("Abs", op.name + ".abs", {in(0)}, {magnitude});
+        auto* reduce = node("ReduceMax", op.name + ".max", {magnitude}, {largest});
+        attr(reduce, "axes", std::vector<int64_t>{1});
+        attr(reduce, "keepdims", int64_t{1});
+        node("Greater", op.name + ".greater",
+             {largest, initializer(op.name + ".threshold", torch::tensor(static_cast<float>(op.threshold)), {})},
+             {above});
+        attr(node("Cast", op.name, {above}, {out}), "to", int64_t{onnx::TensorProto::FLOAT});
+        return;
+      }
     }
     throw Error(op_context(op.name), std::string("the ONNX writer does not know op kind '") +
                                          graph::op_kind_name(op.kind) + "'");
@@ -254,6 +270,67 @@ class Writer {
         return;
     }
     throw Error(op_context(op.name), std::string("unknown resize mode ") + graph::resize_mode_name(op.mode));
+  }
+
+  // GridSample over the grid graph::apply_sample computes, with the same float32 operations
+  // (graph.h sample_grid_base, sample_grid_scale), built from the tensors' shapes so fixed and
+  // dynamic-size files share it: per axis, (float(range(out)) * 2 + 1) / r / float(source) - 1,
+  // stacked to [1, H, W, 2]; the offsets transposed to [N, H, W, 2], times 2 / source, plus that.
+  void emit_sample(const graph::Op& op, const std::string& source, const std::string& offsets, const std::string& out) {
+    const std::string& p = op.name;
+    const auto make = [&](const std::string& type, const std::string& role, const std::vector<std::string>& inputs) {
+      const std::string y = claim(p + "." + role);
+      node(type, p + "." + role, inputs, {y});
+      return y;
+    };
+    const auto to_float = [&](const std::string& role, const std::string& x) {
+      const std::string y = claim(p + "." + role);
+      attr(node("Cast", p + "." + role, {x}, {y}), "to", int64_t{onnx::TensorProto::FLOAT});
+      return y;
+    };
+    const auto axes = [&](const std::string& role, int64_t axis) { return int64_initializer(p + "." + role, {axis}); };
+    const auto concat = [&](const std::string& role, const std::vector<std::string>& parts, int64_t axis) {
+      const std::string y = claim(p + "." + role);
+      attr(node("Concat", p + "." + role, parts, {y}), "axis", axis);
+      return y;
+    };
+    const std::string source_shape = make("Shape", "source_shape", {source});
+    const std::string offsets_shape = make("Shape", "offsets_shape", {offsets});
+    const std::string two = initializer(p + ".two", torch::tensor(2.f), {});
+    const std::string one = initializer(p + ".one", torch::tensor(1.f), {});
+    const std::string ratio = initializer(p + ".ratio", torch::tensor(static_cast<float>(op.factor)), {});
+    const std::string start = b_.int64_scalar(p + ".range_start", 0), step = b_.int64_scalar(p + ".range_step", 1);
+    // Normalized centres along one axis (dim 3: x, dim 2: y) and 2 / the source's size.
+    const auto axis = [&](const std::string& a, int64_t dim) {
+      const std::string index = b_.int64_scalar(p + "." + a + "_dim", dim);
+      const std::string size = to_float(a + "_source_size", make("Gather", a + "_source_dim", {source_shape, index}));
+      const std::string count = make("Gather", a + "_out_dim", {offsets_shape, index});
+      const std::string ramp = to_float(a + "_ramp", make("Range", a + "_range", {start, count, step}));
+      const std::string odd = make("Add", a + "_odd", {make("Mul", a + "_twice", {ramp, two}), one});
+      const std::string lr = make("Div", a + "_lr", {odd, ratio});
+      const std::string centres = make("Sub", a + "_centres", {make("Div", a + "_normalized", {lr, size}), one});
+      return std::make_pair(centres, make("Div", a + "_scale", {two, size}));
+    };
+    const auto [x_centres, x_scale] = axis("x", 3);
+    const auto [y_centres, y_scale] = axis("y", 2);
+    const std::string out_hw = make("Slice", "out_hw", {offsets_shape, int64_initializer(p + ".hw_start", {2}),
+                                                         int64_initializer(p + ".hw_end", {4})});
+    const std::string x_grid = make("Expand", "x_grid", {make("Unsqueeze", "x_row", {x_centres, axes("row_axes", 0)}), out_hw});
+    const std::string y_grid = make("Expand", "y_grid", {make("Unsqueeze", "y_column", {y_centres, axes("column_axes", 1)}), out_hw});
+    const std::string last = axes("last_axes", 2);
+    const std::string stacked = concat("stacked", {make("Unsqueeze", "x_last", {x_grid, last}), make("Unsqueeze", "y_last", {y_grid, last})}, 2);
+    const std::string base = make("Unsqueeze", "grid_base", {stacked, axes("batch_axes", 0)});
+    const std::string first = axes("scale_axes", 0);
+    const std::string scale = concat("grid_scale", {make("Unsqueeze", "x_scale1", {x_scale, first}),
+                                                    make("Unsqueeze", "y_scale1", {y_scale, first})}, 0);
+    const std::string transposed = claim(p + ".offsets_nhwc");
+    attr(node("Transpose", p + ".transpose", {offsets}, {transposed}), "perm", std::vector<int64_t>{0, 2, 3, 1});
+    const std::string grid = make("Add", "grid", {make("Mul", "scaled", {transposed, scale}), base});
+    graph::sample_interpolation(op.mode);  // rejects modes that are not sampling modes
+    auto* n = node("GridSample", op.name, {source, grid}, {out});
+    attr(n, "mode", std::string(op.mode == graph::ResizeMode::Nearest ? "nearest" : "bilinear"));
+    attr(n, "padding_mode", std::string("border"));
+    attr(n, "align_corners", int64_t{0});
   }
 
   // Bicubic upsampling as edge padding + a depthwise conv computing the f*f phases + DepthToSpace

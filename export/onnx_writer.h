@@ -57,6 +57,9 @@ struct OnnxOptions {
 };
 
 inline constexpr int64_t kOnnxOpset = 13;
+// A graph with a Sample op is written at this opset instead (GridSample first appears in 16), so
+// every other export keeps the opset older runtimes import.
+inline constexpr int64_t kOnnxGridSampleOpset = 16;
 
 // The serialized ModelProto, already checked. Throws cgsr::Error naming the op for a graph op or
 // option the writer cannot express.

@@ -48,6 +48,10 @@ std::string opencv_dnn_unsupported_reason(const std::filesystem::path& onnx_file
     return "OpenCV DNN 4.6 imports DepthToSpace/Reshape only at the fixed size written in the file, so it runs "
            "fixed-size exports only; this is a --dynamic-size export (export again with a fixed --input size to run "
            "it in OpenCV DNN)";
+  for (const auto& [type, count] : info.op_counts)
+    if (type == "GridSample")
+      return "OpenCV DNN 4.6 has no GridSample layer (ONNX opset 16), which this export samples by offsets with "
+             "(SRPO's projection)";
   return "";
 }
 

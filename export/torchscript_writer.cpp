@@ -121,6 +121,28 @@ Generated generate(const graph::Graph& graph) {
         expr += "], 1)";
         break;
       }
+      case graph::OpKind::Sample: {
+        // graph::apply_sample's grid, operation for operation (so the same float32 bits).
+        const std::string source = in(0), off = in(1), r = std::to_string(op.factor);
+        const auto centres = [&](const std::string& axis_name, int dim) {
+          const std::string d = std::to_string(dim);
+          src << "    " << y << "_" << axis_name << " = (torch.arange(" << off << ".size(" << d
+              << ")).float() * 2 + 1) / " << r << " / " << source << ".size(" << d << ") - 1\n";
+        };
+        centres("x", 3);
+        centres("y", 2);
+        const std::string size = "[" + off + ".size(2), " + off + ".size(3)]";
+        src << "    " << y << "_base = torch.stack([" << y << "_x.view([1, -1]).expand(" << size << "), " << y
+            << "_y.view([-1, 1]).expand(" << size << ")], -1).unsqueeze(0)\n";
+        src << "    " << y << "_scale = torch.full([2], 2.0) / torch.tensor([float(" << source << ".size(3)), float("
+            << source << ".size(2))])\n";
+        expr = "torch.grid_sampler(" + source + ", " + off + ".permute([0, 2, 3, 1]) * " + y + "_scale + " + y +
+               "_base, " + std::to_string(graph::sample_interpolation(op.mode)) + ", 1, False)";
+        break;
+      }
+      case graph::OpKind::AnyAbsAbove:
+        expr = "(" + in(0) + ".abs().amax(1, True) > " + literal(op.threshold) + ").float()";
+        break;
     }
     if (expr.empty())
       throw Error("torchscript export: op '" + op.name + "'",

@@ -88,6 +88,8 @@ torch::Tensor torch_kernel(const Op& op, const std::vector<torch::Tensor>& x) {
     case OpKind::Add: return x[0] + x[1];
     case OpKind::Mul: return x[0] * x[1];
     case OpKind::Concat: return torch::cat(x, 1);
+    case OpKind::Sample: return graph::apply_sample(x[0], x[1], op.factor, op.mode);
+    case OpKind::AnyAbsAbove: return graph::apply_any_abs_above(x[0], op.threshold);
   }
   CGSR_CHECK(false, "fused graph: unknown op kind");
 }
@@ -421,6 +423,14 @@ class Compiler {
         }
         case OpKind::Resize: y = {x[0], x[1], x[2] * op.factor, x[3] * op.factor}; break;
         case OpKind::AvgPool: y = {x[0], x[1], x[2] / op.factor, x[3] / op.factor}; break;
+        case OpKind::Sample: {
+          const Dims& offsets = p_.dims[op.inputs[1]];
+          CGSR_CHECK(offsets[1] == 2 && offsets[2] == x[2] * op.factor && offsets[3] == x[3] * op.factor,
+                     where + ": offsets " + dims_string(offsets) + " do not match the source " + dims_string(x));
+          y = {x[0], x[1], offsets[2], offsets[3]};
+          break;
+        }
+        case OpKind::AnyAbsAbove: y[1] = 1; break;
         case OpKind::Add:
         case OpKind::Mul:
           CGSR_CHECK(p_.dims[op.inputs[1]] == x, where + ": operands of different shapes " + dims_string(x) +
@@ -843,6 +853,10 @@ class Compiler {
         call.values = {{DNNL_ARG_FROM, x, from}, {DNNL_ARG_TO, y, to}};
         break;
       }
+      // oneDNN has no gather-by-offsets or threshold primitive: LibTorch runs them (the
+      // interpreter's kernels, so the fused path computes the same bits).
+      case OpKind::Sample:
+      case OpKind::AnyAbsAbove: return false;
       case OpKind::Conv:
       case OpKind::Add:
       case OpKind::Mul: CGSR_CHECK(false, "fused graph: planned elsewhere");

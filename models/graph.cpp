@@ -44,6 +44,8 @@ const char* op_kind_name(OpKind kind) {
     case OpKind::Add: return "add";
     case OpKind::Mul: return "mul";
     case OpKind::Concat: return "concat";
+    case OpKind::Sample: return "sample";
+    case OpKind::AnyAbsAbove: return "any_abs_above";
   }
   return "?";
 }
@@ -60,7 +62,11 @@ OpTraits op_traits(OpKind kind) {
     case OpKind::AvgPool:
     case OpKind::Add:
     case OpKind::Mul:
-    case OpKind::Concat: return {};
+    case OpKind::Concat:
+    // Output channel c samples source channel c; the offsets are a fixed 2-channel axis.
+    case OpKind::Sample:
+    // A fixed 1-channel output of a fixed input (the offsets).
+    case OpKind::AnyAbsAbove: return {};
   }
   return {};
 }
@@ -294,6 +300,35 @@ int Builder::concat(const std::vector<int>& parts) {
   return push(std::move(op), std::move(out));
 }
 
+int Builder::sample(int source, int offsets, ResizeMode mode) {
+  const Value& src = value(source);
+  const Value& off = value(offsets);
+  const std::string what = "graph: sampling " + src.name + " at " + off.name;
+  CGSR_CHECK(layout_width(off.layout) == 2 && off.layout.size() == 1 && !off.layout[0].prunable,
+             what + ": the offsets must be one fixed 2-channel axis (dx, dy), got " + layout_string(off.layout));
+  CGSR_CHECK(off.factor % src.factor == 0, what + ": the offsets' factor " + std::to_string(off.factor) +
+                                               " is not a multiple of the source's " + std::to_string(src.factor));
+  CGSR_CHECK(mode != ResizeMode::Bicubic, what + ": sampling is nearest or bilinear");
+  Value out = src;
+  out.factor = off.factor;
+  Op op;
+  op.kind = OpKind::Sample;
+  op.inputs = {source, offsets};
+  op.name = auto_name(op.kind);
+  op.factor = off.factor / src.factor;
+  op.mode = mode;
+  return push(std::move(op), std::move(out));
+}
+
+int Builder::any_abs_above(int x, double threshold) {
+  Value out = value(x);
+  out.layout = fixed_layout("mask", 1);
+  Op op = unary(OpKind::AnyAbsAbove, x);
+  op.name = auto_name(op.kind);
+  op.threshold = threshold;
+  return push(std::move(op), std::move(out));
+}
+
 // ---- kernels -----------------------------------------------------------------------------------
 
 torch::Tensor apply_resize(const torch::Tensor& x, int64_t factor, ResizeMode mode) {
@@ -317,6 +352,49 @@ torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, c
   if (scale.defined()) y = y * scale.view({1, -1, 1, 1});
   if (shift.defined()) y = y + shift.view({1, -1, 1, 1});
   return y;
+}
+
+namespace {
+// Normalized source coordinate of the centre of each of n output pixels: ((2j + 1) / r) / size - 1.
+torch::Tensor normalized_centres(int64_t n, int64_t ratio, int64_t size) {
+  return (torch::arange(n, torch::kFloat) * 2 + 1) / ratio / size - 1;
+}
+}  // namespace
+
+torch::Tensor sample_grid_base(int64_t out_h, int64_t out_w, int64_t ratio, int64_t source_h, int64_t source_w) {
+  const auto x = normalized_centres(out_w, ratio, source_w).view({1, out_w}).expand({out_h, out_w});
+  const auto y = normalized_centres(out_h, ratio, source_h).view({out_h, 1}).expand({out_h, out_w});
+  return torch::stack({x, y}, -1).unsqueeze(0);
+}
+
+torch::Tensor sample_grid_scale(int64_t source_h, int64_t source_w) {
+  // float32 division (not double rounded to float), as the exporters divide.
+  return torch::full({2}, 2.0f) / torch::tensor({static_cast<float>(source_w), static_cast<float>(source_h)});
+}
+
+int64_t sample_interpolation(ResizeMode mode) {
+  switch (mode) {
+    case ResizeMode::Bilinear: return 0;
+    case ResizeMode::Nearest: return 1;
+    case ResizeMode::Bicubic: break;
+  }
+  throw Error("sample", std::string("mode ") + resize_mode_name(mode) + " is not a sampling mode (nearest, bilinear)");
+}
+
+torch::Tensor apply_sample(const torch::Tensor& source, const torch::Tensor& offsets, int64_t ratio, ResizeMode mode) {
+  CGSR_CHECK(source.dim() == 4 && offsets.dim() == 4 && offsets.size(1) == 2 && offsets.size(0) == source.size(0) &&
+                 offsets.size(2) == source.size(2) * ratio && offsets.size(3) == source.size(3) * ratio,
+             "sample: offsets " + shape_string(offsets) + " must be [N, 2, " + std::to_string(ratio) +
+                 " x the height, width] of the source " + shape_string(source));
+  const int64_t h = source.size(2), w = source.size(3);
+  const auto grid = offsets.permute({0, 2, 3, 1}) * sample_grid_scale(h, w).to(offsets.options()) +
+                    sample_grid_base(offsets.size(2), offsets.size(3), ratio, h, w).to(offsets.options());
+  return torch::grid_sampler(source, grid, sample_interpolation(mode), /*padding_mode=border*/ 1,
+                             /*align_corners=*/false);
+}
+
+torch::Tensor apply_any_abs_above(const torch::Tensor& x, double threshold) {
+  return (x.abs().amax(1, /*keepdim=*/true) > threshold).to(x.scalar_type());
 }
 
 Graph rewrite(const Graph& graph, const std::vector<std::optional<Op>>& ops, const std::vector<int>& alias) {
@@ -388,6 +466,8 @@ std::vector<std::pair<std::string, torch::Tensor>> run(
         y = torch::cat(parts, 1);
         break;
       }
+      case OpKind::Sample: y = apply_sample(in(0), in(1), op.factor, op.mode); break;
+      case OpKind::AnyAbsAbove: y = apply_any_abs_above(in(0), op.threshold); break;
     }
     values[op.output] = observer ? observer(index, y) : y;
     if (op_ms)

@@ -33,6 +33,19 @@
 //                  scale).
 //   Add, Mul       [a, b] -> element-wise; operands have identical shapes (no broadcasting).
 //   Concat         [a, b, ...] -> concatenation along channels.
+//   Sample         [source (factor a), offsets (factor b, 2 fixed channels dx, dy)] -> the
+//                  source's channels at factor b; b must be a multiple of a, r = b / a. Output
+//                  pixel (i, j) reads the source at x = (j + 0.5) / r - 0.5 + dx(i, j),
+//                  y = (i + 0.5) / r - 0.5 + dy(i, j), in source pixels (half-pixel centres, so
+//                  zero offsets are nearest/bilinear upsampling by r; r = 1 warps by a motion
+//                  field). `mode` Nearest rounds x and y half to even (nearbyint) and clamps the
+//                  index to the image; Bilinear clamps x and y to [0, size - 1] and interpolates
+//                  (border padding). Computed as grid_sampler(source, grid, align_corners=False,
+//                  padding border) with the normalized grid of sample_grid() below, which the
+//                  exporters write with the same float operations (ONNX GridSample, opset 16).
+//   AnyAbsAbove    [x] -> 1 channel (fixed "mask"): 1 where max over channels |x[c]| > threshold,
+//                  else 0. With threshold 0.5 it is the indicator round(x) != 0 (half to even:
+//                  round(+-0.5) = 0), SRPO's "this pixel was moved" (models/backbones/srpo.h).
 //
 // Values carry a channel Layout: which prunable layer group (see arch_spec.h) owns each channel
 // position. Ops that tie channels together (Add, Mul) require identical layouts, so a graph can
@@ -77,7 +90,9 @@ struct Value {
   int64_t factor = 1;  // spatial size = factor x the LR input size
 };
 
-enum class OpKind { Conv, Relu, LeakyRelu, Sigmoid, PixelShuffle, Resize, AvgPool, ChannelAffine, Add, Mul, Concat };
+enum class OpKind {
+  Conv, Relu, LeakyRelu, Sigmoid, PixelShuffle, Resize, AvgPool, ChannelAffine, Add, Mul, Concat, Sample, AnyAbsAbove
+};
 enum class ResizeMode { Nearest, Bilinear, Bicubic };
 
 const char* op_kind_name(OpKind kind);        // "conv", "leaky_relu", ...
@@ -95,9 +110,12 @@ struct Op {
   bool trainable = true;
   // LeakyRelu
   double negative_slope = 0.0;
-  // PixelShuffle (upscale), Resize (scale), AvgPool (kernel = stride)
+  // PixelShuffle (upscale), Resize (scale), AvgPool (kernel = stride), Sample (output factor /
+  // source factor)
   int64_t factor = 1;
-  ResizeMode mode = ResizeMode::Nearest;
+  ResizeMode mode = ResizeMode::Nearest;  // Resize; Sample (Nearest or Bilinear)
+  // AnyAbsAbove
+  double threshold = 0.0;
   // ChannelAffine
   torch::Tensor scale, shift;
 
@@ -178,6 +196,14 @@ class Builder {
   int add(int a, int b);
   int mul(int a, int b);
   int concat(const std::vector<int>& parts);
+  // `offsets` must be a 2-channel fixed value whose factor is a multiple of the source's.
+  int sample(int source, int offsets, ResizeMode mode);
+  int any_abs_above(int x, double threshold);
+
+  // The graph being written is the training graph (SRNetworkImpl::describe(true)): ops whose
+  // train() behaviour differs from eval() (SRPO's bilinear projection) write the training one.
+  void set_training(bool training) { training_ = training; }
+  bool training() const { return training_; }
 
   const Value& value(int index) const { return graph_.values.at(index); }
   Graph finish() { return std::move(graph_); }
@@ -188,6 +214,7 @@ class Builder {
   int push(Op op, Value out);
   Graph graph_;
   std::string prefix_;
+  bool training_ = false;
 };
 
 // A graph rewritten: `ops[i]` replaces op i (nullopt drops it; it keeps the original value
@@ -199,6 +226,19 @@ Graph rewrite(const Graph& graph, const std::vector<std::optional<Op>>& ops, con
 torch::Tensor apply_resize(const torch::Tensor& x, int64_t factor, ResizeMode mode);
 torch::Tensor apply_avg_pool(const torch::Tensor& x, int64_t factor);
 torch::Tensor apply_affine(const torch::Tensor& x, const torch::Tensor& scale, const torch::Tensor& shift);
+torch::Tensor apply_sample(const torch::Tensor& source, const torch::Tensor& offsets, int64_t ratio, ResizeMode mode);
+torch::Tensor apply_any_abs_above(const torch::Tensor& x, double threshold);
+
+// The Sample op's grid in grid_sampler's normalized coordinates (align_corners=False):
+// grid = offsets (as [N, H, W, 2]) * sample_grid_scale + sample_grid_base, all float32, so every
+// runtime that repeats these two operations gets the same bits.
+//   sample_grid_base: [1, out_h, out_w, 2], x: ((2j + 1) / r) / source_w - 1 (y likewise), the
+//                     normalized source position of output pixel j's centre
+//   sample_grid_scale: [2], 2 / source_w and 2 / source_h in float32 (source pixels to normalized units)
+torch::Tensor sample_grid_base(int64_t out_h, int64_t out_w, int64_t ratio, int64_t source_h, int64_t source_w);
+torch::Tensor sample_grid_scale(int64_t source_h, int64_t source_w);
+// grid_sampler's interpolation_mode of a Sample mode (0 bilinear, 1 nearest); Error for bicubic.
+int64_t sample_interpolation(ResizeMode mode);
 
 // Called after each op with its index in graph.ops and its output; returns the value the later
 // ops see (the output itself, or e.g. a masked copy). Lets callers observe or adjust activations

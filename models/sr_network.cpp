@@ -101,6 +101,7 @@ graph::Graph SRNetworkImpl::describe_branches() const { return describe_graph(fa
 
 graph::Graph SRNetworkImpl::describe_graph(bool training) const {
   graph::Builder g;
+  g.set_training(training);
   const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
   const int info = has_rit() ? g.input(rit_->input_name(), info_layout(input_channels()), rit_->info_factor()) : -1;
   ExtractedPorts extracted;

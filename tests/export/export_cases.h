@@ -68,6 +68,9 @@ inline std::vector<ExportCase> export_cases() {
   cases.push_back({"srcnn_x3_rit_hr_fuse_concat", with_rit(default_spec("srcnn", 3), "hr_fuse", "concat")});
   cases.push_back({"shrunk_edsr_x4", shrunk_edsr(4)});
   cases.push_back({"span_x2_rit_hr_unshuffle_concat", with_rit(default_spec("span", 2), "hr_unshuffle", "concat")});
+  // CG-enhanced SRPO: the RIT at its LR features and its HR features (after the upsampling).
+  cases.push_back({"srpo_x2_rit_hr_unshuffle_hr_fuse_concat",
+                   with_rit(default_spec("srpo", 2), "hr_unshuffle+hr_fuse", "concat")});
   ArchSpec bicubic_skip = default_spec("pan", 3);
   bicubic_skip.image_skip = ImageSkip::Bicubic;
   cases.push_back({"pan_x3_bicubic_skip", bicubic_skip});

@@ -4,10 +4,12 @@
 
 #include <torch/torch.h>
 
+#include "core/atomic_file.h"
 #include "export/onnx_writer.h"
 #include "models/model_file.h"
 #include "tests/export/export_cases.h"
 #include "tests/support/cli_runner.h"
+#include "tests/support/tiny_data.h"
 
 namespace cgsr {
 namespace {
@@ -44,6 +46,34 @@ TEST(ExportCommand, SizeFreeExportsVerifyAtTwoSizesAndSayWhyOpenCvIsSkipped) {
   ASSERT_EQ(ts.exit_code, 0) << ts.out << ts.err;
   EXPECT_NE(ts.out.find("4 passed, 0 failed, 0 skipped"), std::string::npos) << ts.out;
   for (const char* runtime : {"libtorch", "python-torch"}) EXPECT_NE(ts.out.find(runtime), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// CG-enhanced SRPO end to end: `cgsr train` adds the RIT at SRPO's LR and HR features and trains
+// a step, `cgsr export --verify` writes it (GridSample, so opset 16) and checks it in ONNX
+// Runtime; OpenCV DNN is skipped with the reason.
+TEST(ExportCommand, CgEnhancedSrpoTrainsAStepThenExportsAndVerifiesInOnnxRuntime) {
+  const auto dir = test::scratch_dir("export-cli-srpo");
+  const auto config = dir / "train.yaml";
+  write_file_atomic(config, "data: " + test::tiny_data().string() +
+                         "\nmodel: srpo\nscale: 2\n"
+                         "enhance: {enabled: true, rit: {channels: [depth, edge], source: hr_unshuffle+hr_fuse}}\n"
+                         "schedule: {steps: 1, batch_size: 2, patch_size: 16, val_frames: 1, validate_every: 0}\n"
+                         "loss: {image_norm: l1}\n");
+  const auto run = dir / "run";
+  const auto trained = test::run_cgsr("train --config " + config.string() + " --threads 1 --out " + run.string());
+  ASSERT_EQ(trained.exit_code, 0) << trained.out << trained.err;
+  const ModelFileContents model = read_model_file(run / "model.cgsr");
+  EXPECT_EQ(model.spec.backbone, "srpo");
+  EXPECT_TRUE(model.spec.rit.enabled);
+  const auto out = dir / "srpo.onnx";
+  const auto r = test::run_cgsr("export --model " + (run / "model.cgsr").string() +
+                                " --format onnx --input 12x10 --verify --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("1 passed, 0 failed, 1 skipped"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no GridSample layer"), std::string::npos) << r.out;
+  const OnnxModelInfo info = inspect_onnx_file(out);
+  EXPECT_EQ(info.opset, kOnnxGridSampleOpset);
   std::filesystem::remove_all(dir);
 }
 

@@ -15,6 +15,9 @@
 
 #include "core/tensor_checks.h"
 #include "export/exporter.h"
+#include "export/onnx_writer.h"
+#include "export/onnxruntime_runner.h"
+#include "export/torchscript_writer.h"
 #include "export/verification.h"
 #include "tests/models/numerics_cases.h"
 #include "tests/support/cli_runner.h"
@@ -139,6 +142,69 @@ TEST(OnnxNumerics, ExtremeRenderingInformationMatchesTheEnginesForEveryRitSource
     }
   }
   run.expect_match();
+}
+
+// The Sample op's rounding and clamping in the exported files: a graph whose offsets are the
+// input's own R and G channels (nearest-upsampled through a fixed 1x1 conv), so the test sets
+// every offset, at an 8x8 frame (power-of-two sizes keep the normalized grid exact): exact
+// halves (round half to even, nearbyint), positions beyond the border (clamped) and others.
+// ONNX Runtime (fixed and dynamic size) and TorchScript must pick the very pixels our kernel
+// picks: the outputs are equal, not close.
+TEST(OnnxNumerics, SampleRoundsHalvesToEvenAndClampsAsOurKernelDoes) {
+  const int64_t size = 8, r = 2;
+  graph::Builder g;
+  const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
+  const int up = g.resize(color, r, graph::ResizeMode::Nearest);
+  const auto pick_rg = torch::tensor({1.f, 0.f, 0.f, 0.f, 1.f, 0.f}).view({2, 3, 1, 1});
+  const int offsets = g.conv("offsets", up, pick_rg, torch::Tensor(), 0, graph::fixed_layout("offsets", 2), false);
+  for (const auto mode : {graph::ResizeMode::Nearest, graph::ResizeMode::Bilinear}) {
+    SCOPED_TRACE(graph::resize_mode_name(mode));
+    graph::Builder copy = g;
+    copy.output("image", copy.sample(color, offsets, mode));
+    const graph::Graph graph = copy.finish();
+    // Output column j of block (i, j) sits at j / 2 - 0.25: odd quarters make .5 ties half the time.
+    auto generator = at::detail::createCPUGenerator(17);
+    const auto quarters = torch::randint(-12, 12, {1, 2, size, size}, generator) * 2 + 1;  // odd
+    auto rg = quarters.to(torch::kFloat) / 4;
+    rg.select(3, 0).fill_(-40.f);  // far beyond the left and top borders
+    rg.select(2, size - 1).fill_(37.25f);
+    const auto ids = torch::arange(size * size, torch::kFloat).view({1, 1, size, size});
+    const auto x = torch::cat({rg, ids}, 1);
+    const auto ours = graph::run(graph, {{"color", x}})[0].second;
+    if (mode == graph::ResizeMode::Nearest) {
+      // Ties occurred, and each resolved to the even column or row.
+      const auto positions = torch::arange(size * r, torch::kFloat) / r - 0.25;
+      const auto dx = graph::apply_resize(rg, r, graph::ResizeMode::Nearest).select(1, 0)[0];
+      const auto at = positions.view({1, -1}) + dx;
+      const auto ties = (at - at.floor()) == 0.5;
+      ASSERT_GT(ties.sum().item<int64_t>(), 10);
+      const auto picked_column = torch::remainder(ours.select(1, 2)[0], size);
+      const auto expected_column = torch::clamp(torch::round(at), 0, size - 1);  // torch::round: half to even
+      EXPECT_TRUE(torch::equal(picked_column, expected_column));
+    }
+    const auto dir = test::scratch_dir("sample-rounding");
+    const OnnxRuntimeRunner runner(1);
+    for (const bool dynamic : {false, true}) {
+      OnnxOptions o;
+      o.width = size;
+      o.height = size;
+      o.dynamic_size = dynamic;
+      const auto file = dir / (std::string(dynamic ? "dynamic" : "fixed") + ".onnx");
+      write_onnx(file, graph, o);
+      EXPECT_EQ(inspect_onnx_file(file).opset, kOnnxGridSampleOpset);
+      const auto result = runner.run_checked({OrtModelJob{file, {OrtRun{{{kExportColorInput, x}}, 0, 1}}}}).front();
+      const auto theirs = find_tensor(result.runs.at(0).outputs, kExportOutput);
+      ASSERT_TRUE(theirs.defined());
+      if (mode == graph::ResizeMode::Nearest)
+        EXPECT_TRUE(torch::equal(theirs, ours)) << (dynamic ? "dynamic" : "fixed");
+      else
+        EXPECT_LT((theirs - ours).abs().max().item<double>(), 1e-5) << (dynamic ? "dynamic" : "fixed");
+    }
+    auto module = torchscript_module(graph);
+    const auto scripted = module.forward({x}).toTensor();
+    EXPECT_TRUE(torch::equal(scripted, ours));
+    std::filesystem::remove_all(dir);
+  }
 }
 
 }  // namespace

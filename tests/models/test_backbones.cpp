@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include "core/color.h"
+#include "models/backbones/srpo.h"
 #include "models/backbone_registry.h"
 #include "models/complexity.h"
 #include "models/sr_network.h"
@@ -26,12 +28,15 @@ std::optional<int64_t> reference_params(const cgsr::test::BackboneCase& c) {
   // Deployed (branches folded), as the reference implementation's eval_conv layers hold them; x3
   // differs from x2 in the upsampler only: 48 x 27 x 9 + 27 against 48 x 12 x 9 + 12.
   if (c.backbone == "span") return c.scale == 2 ? 410700 : c.scale == 3 ? 417195 : 426288;
+  // Sec. 3.1: "The entire network contains 8434 learnable parameters"; x3 only changes the
+  // upsampling, so every scale has them.
+  if (c.backbone == "srpo") return 8434;
   return std::nullopt;
 }
 }  // namespace
 
 TEST(Backbones, RegistryListsTheZoo) {
-  EXPECT_EQ(backbone_registry().names(), (std::vector<std::string>{"edsr", "pan", "span", "srcnn"}));
+  EXPECT_EQ(backbone_registry().names(), (std::vector<std::string>{"edsr", "pan", "span", "srcnn", "srpo"}));
   try {
     default_spec("pann", 2);
     FAIL() << "unknown backbone accepted";
@@ -133,4 +138,90 @@ TEST(Backbones, SrcnnLumaReplacesLumaAndKeepsBicubicChroma) {
   const auto delta = out - bicubic;
   EXPECT_TRUE(torch::allclose(delta.select(1, 0), delta.select(1, 1), 1e-5, 1e-5));
   EXPECT_TRUE(torch::allclose(delta.select(1, 0), delta.select(1, 2), 1e-5, 1e-5));
+}
+
+namespace {
+void set_parameter(SRNetworkImpl& net, const std::string& name, const std::function<void(torch::Tensor&)>& set) {
+  torch::NoGradGuard no_grad;
+  for (auto& p : net.named_parameters())
+    if (p.key() == name) set(p.value());
+}
+}  // namespace
+
+// The check: with the offsets at zero, SRPO's projection is nearest-neighbour upsampling
+// (the inference graph's Sample op, observed), and the fusion then keeps the bicubic image only
+// (no pixel moved, alpha = 0).
+TEST(Srpo, ZeroOffsetsProjectToNearestUpsamplingAndFuseToBicubic) {
+  torch::manual_seed(5);
+  for (int scale : {2, 3, 4}) {
+    SCOPED_TRACE("x" + std::to_string(scale));
+    SRNetwork net(spec_for({"srpo", scale, "rgb"}));
+    net->eval();
+    set_parameter(*net, "backbone.conv3.weight", [](torch::Tensor& t) { t.zero_(); });
+    set_parameter(*net, "backbone.conv3.bias", [](torch::Tensor& t) { t.zero_(); });
+    const auto x = torch::rand({1, 3, 7, 6});
+    const auto g = net->describe(false);
+    torch::Tensor projected;
+    graph::run(g, {{"color", x}}, nullptr, [&](size_t i, const torch::Tensor& y) {
+      if (g.ops[i].kind == graph::OpKind::Sample) projected = y;
+      return y;
+    });
+    ASSERT_TRUE(projected.defined());
+    EXPECT_TRUE(torch::equal(projected, graph::apply_resize(x, scale, graph::ResizeMode::Nearest)));
+    torch::NoGradGuard no_grad;
+    EXPECT_TRUE(torch::equal(net->forward(x), graph::apply_resize(x, scale, graph::ResizeMode::Bicubic)));
+  }
+}
+
+// Inference (eval): nearest projection fused with bicubic; the inference graph computes the same
+// bits. Training (train): the bilinear projection itself, differentiable in the offsets.
+TEST(Srpo, EvalFusesTheNearestProjectionAndTrainReturnsTheBilinearOne) {
+  torch::manual_seed(6);
+  for (int scale : {2, 3, 4}) {
+    SCOPED_TRACE("x" + std::to_string(scale));
+    SRNetwork net(spec_for({"srpo", scale, "rgb"}));
+    set_parameter(*net, "backbone.conv3.weight", [](torch::Tensor& t) { t.mul_(30); });  // offsets of a few pixels
+    const auto x = torch::rand({2, 3, 9, 8});
+    net->eval();
+    torch::Tensor fused;
+    {
+      torch::NoGradGuard no_grad;
+      fused = net->forward(x);
+      EXPECT_TRUE(torch::equal(graph::run(net->describe(false), {{"color", x}})[0].second, fused));
+    }
+    const auto bicubic = graph::apply_resize(x, scale, graph::ResizeMode::Bicubic);
+    EXPECT_GT((fused - bicubic).abs().max().item<float>(), 1e-3);  // some pixels moved
+    net->train();
+    const auto projected = net->forward(x);
+    EXPECT_FALSE(torch::allclose(projected, fused));
+    projected.sum().backward();
+    for (const auto& p : net->named_parameters()) {
+      if (p.key() == "backbone.conv3.weight") {
+        EXPECT_GT(p.value().grad().abs().sum().item<float>(), 0.f);
+      }
+    }
+    {
+      torch::NoGradGuard no_grad;
+      EXPECT_TRUE(torch::equal(graph::run(net->describe(true), {{"color", x}})[0].second, net->forward(x)));
+    }
+    for (const auto& [graph_kind, mode] : {std::pair{true, graph::ResizeMode::Bilinear},
+                                           std::pair{false, graph::ResizeMode::Nearest}}) {
+      int samples = 0;
+      for (const auto& op : net->describe(graph_kind).ops) {
+        if (op.kind != graph::OpKind::Sample) continue;
+        ++samples;
+        EXPECT_EQ(op.mode, mode);
+      }
+      EXPECT_EQ(samples, 1);
+    }
+  }
+}
+
+TEST(Srpo, ComplexityCountsTheOffsetNetwork) {
+  SRNetwork net(spec_for({"srpo", 2, "rgb"}));
+  const auto c = complexity(*net, 10, 10);
+  EXPECT_EQ(c.params, 8434);
+  // conv1 1,200 + conv2 6,400 MACs per LR pixel, conv3 800 per HR pixel (4 per LR pixel), and
+  // the fusion's fixed 3x3 Gaussian (27 per HR pixel).
+  EXPECT_EQ(c.macs, 100 * (1200 + 6400 + 4 * 800 + 4 * 27));
 }

@@ -136,6 +136,28 @@ TEST_F(FusedGraphTest, EveryBackboneAtEveryScale) {
     }
 }
 
+// SRPO's sampling by offsets and its mask run as LibTorch steps inside the plan; with offsets of
+// several pixels (trained-looking, not the near-zero ones of a fresh network) many pixels move,
+// and the plan picks the pixels the interpreter picks.
+TEST_F(FusedGraphTest, SrpoWithOffsetsOfSeveralPixels) {
+  uint64_t seed = 70;
+  for (int scale : {2, 3, 4}) {
+    SCOPED_TRACE("srpo x" + std::to_string(scale));
+    SRNetwork net = build_network(default_spec("srpo", scale), ++seed);
+    {
+      torch::NoGradGuard no_grad;
+      net->named_parameters()["backbone.conv3.weight"].mul_(30);
+    }
+    const graph::Graph g = net->describe();
+    FusedGraph fused(g);
+    const auto in = random_of(net->spec(), 2, 12, 17);
+    expect_equal_outputs(fused, g, in);
+    torch::NoGradGuard no_grad;
+    const auto bicubic = graph::apply_resize(in[0].second, scale, graph::ResizeMode::Bicubic);
+    EXPECT_GT((fused.run(in)[0].second - bicubic).abs().gt(1e-3).sum().item<int64_t>(), 100);
+  }
+}
+
 // A bicubic image skip runs as a LibTorch step inside the plan (oneDNN resamples nearest and
 // linear only).
 TEST_F(FusedGraphTest, BicubicImageSkip) {
