@@ -25,6 +25,22 @@ config::Schema<AblationOptions> ablation_schema_fields() {
   s.field("sources", &AblationOptions::sources, "RIT sources to compare (rit.h)");
   s.section("rit", &AblationOptions::rit, rit_spec_schema(), "the RIT of every CG-enhanced variant");
   s.field("leave_out", &AblationOptions::leave_out, "the best source with each rendering channel left out in turn");
+  s.field("channel_sets", &AblationOptions::channel_sets,
+          "channel lists to try at the best source besides rit.channels (render_channels.h names)")
+      .check(
+          [](const std::vector<std::vector<std::string>>& sets) {
+            for (const auto& set : sets) {
+              if (set.empty()) return false;
+              try {
+                parse_channels(set);
+              } catch (const Error&) {
+                return false;
+              }
+            }
+            return true;
+          },
+          "every set needs at least one channel, each a render channel name (" +
+              join(channel_names(all_render_channels())) + ") at most once");
   s.field("small_width", &AblationOptions::small_width, "width factor of the small networks (0 = none)").range(0, 1);
   s.field("seeds", &AblationOptions::seeds, "seeds; every variant trains once per seed")
       .check([](const std::vector<int64_t>& v) { return !v.empty(); }, "needs at least one seed");
@@ -205,6 +221,14 @@ AblationResult run_ablation(const SRNetworkImpl& parent, const Dataset& data, co
       RitSpec rit = options.rit;
       rit.channels.erase(std::find(rit.channels.begin(), rit.channels.end(), channel));
       result.rows.push_back(runner.run({result.best_source + " - " + channel, "leave_out", with_source(plain, rit, best)}));
+    }
+  if (!result.best_source.empty())
+    for (const auto& channels : options.channel_sets) {
+      RitSpec rit = options.rit;
+      rit.channels = channels;
+      const ArchSpec spec = with_source(plain, rit, best);
+      const std::string name = result.best_source + " [" + join(spec.rit.channels, "+") + "]";
+      result.rows.push_back(runner.run({name, "channels", spec}));
     }
   if (options.small_width > 0) {
     const ArchSpec small = shrunk(plain, options.small_width);

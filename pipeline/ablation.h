@@ -8,6 +8,8 @@
 //   <source>              CG-enhanced with each RIT source (lr, hr_pooled, hr_unshuffle, hr_fuse,
 //                         hr_unshuffle+hr_fuse), the fusion starting at zero
 //   <best> - <channel>    the best source (by validation PSNR) with one rendering channel left out
+//   <best> [a+b+...]      the best source with another set of rendering channels (channel_sets):
+//                         e.g. the usual G-buffers plus the BSP border channel, or that alone
 //   small plain / small + <best>   the plain network at `small_width` of every width (channels
 //                         inherited by importance, about small_width^2 of the parameters), without
 //                         and with the best source: how much of the gap to the full network the
@@ -40,6 +42,9 @@ struct AblationOptions {
                                     RitSource::HrUnshuffleHrFuse};
   RitSpec rit;               // every CG variant's RIT (channels, widths, fusion, depth encoding)
   bool leave_out = true;     // the best source with each channel left out in turn
+  // The best source with each of these channel lists instead of rit.channels (render_channels.h
+  // names), after the leave-out variants.
+  std::vector<std::vector<std::string>> channel_sets;
   double small_width = 0.5;  // width factor of the small networks; 0 = none
   std::vector<int64_t> seeds = {1, 2};
   TrainSchedule schedule;
@@ -50,7 +55,7 @@ config::Schema<AblationOptions> ablation_schema_fields();
 
 struct AblationVariant {
   std::string name;  // "plain (control)", "hr_fuse", "hr_fuse - depth", "small + hr_fuse", ...
-  std::string kind;  // control | source | leave_out | small
+  std::string kind;  // control | source | leave_out | channels | small
   ArchSpec spec;
 };
 

@@ -28,6 +28,21 @@ torch::Tensor augment_color(const torch::Tensor& color, const ColorAugmentation&
   return a.gain == 1.0f ? t.contiguous() : t.mul(a.gain).clamp_(0, 1);
 }
 
+torch::Tensor augment_info_color(const torch::Tensor& info, const std::vector<RenderChannel>& channels,
+                                 const ColorAugmentation& a) {
+  const int64_t cdim = info.dim() - 3;
+  int64_t offset = 0;
+  for (auto c : channels) {
+    if (c == RenderChannel::Bsp) {
+      torch::Tensor out = info.clone();
+      out.narrow(cdim, offset, 3).copy_(augment_color(info.narrow(cdim, offset, 3), a));
+      return out;
+    }
+    offset += channel_width(c);
+  }
+  return info;
+}
+
 torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a) {
   const int64_t h = image.dim() - 2, w = image.dim() - 1;
   torch::Tensor t = a.flip ? image.flip({w}) : image;

@@ -13,6 +13,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/text.h"
+#include "render_data/bsp_channel.h"
 #include "render_data/derive_channels.h"
 #include "render_data/frame_files.h"
 #include "render_data/render_job.h"
@@ -78,6 +79,12 @@ double default_frame_cache_reserve_gb() {
   return gb > 0 ? gb / 8 : 1.0;
 }
 
+bool bsp_available_at(const DatasetInfo& info, size_t resolution) {
+  if (!info.bsp_border || info.resolutions.empty()) return false;
+  const Resolution& lo = info.resolutions.front(), &r = info.resolutions.at(resolution);
+  return r.width % lo.width == 0 && r.height % lo.height == 0 && r.width / lo.width == r.height / lo.height;
+}
+
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
   const auto derive = parse_channels(options.derive);
   auto stored = [&](RenderChannel c) { return std::find(info.stored.begin(), info.stored.end(), c) != info.stored.end(); };
@@ -86,6 +93,9 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
     requested = info.stored;
     for (auto c : derive)
       if (!stored(c)) requested.push_back(c);
+    // Every channel the data can give: bsp too when it has the BSP files.
+    if (info.bsp_border && std::find(requested.begin(), requested.end(), RenderChannel::Bsp) == requested.end())
+      requested.push_back(RenderChannel::Bsp);
     std::sort(requested.begin(), requested.end());
   } else {
     requested = parse_channels(options.channels);
@@ -93,6 +103,14 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
   info.derived.clear();
   for (auto c : requested) {
     if (stored(c)) continue;
+    if (c == RenderChannel::Bsp) {
+      if (!info.bsp_border)
+        throw Error(info.root.string(),
+                    "the dataset has no sub-pixel BSP border files, which the 'bsp' channel is made from: render it with "
+                    "bsp_border: {depth: 2} in each scene's config (cgsr render; docs/bsp_border.md)");
+      info.derived.push_back(c);
+      continue;
+    }
     const bool asked = std::find(derive.begin(), derive.end(), c) != derive.end();
     if (!asked || !derivable(c))
       throw Error(info.root.string(), "the dataset has no '" + channel_name(c) + "' channel (stored: " +
@@ -100,20 +118,29 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
                                           (derivable(c) ? "; list it under derive to compute it from depth" : ""));
     info.derived.push_back(c);
   }
-  if (!info.derived.empty() && !stored(RenderChannel::Depth))
-    throw Error(info.root.string(), "cannot derive " + join(channel_names(info.derived)) + ": the dataset has no depth");
+  if (!depth_derived(info).empty() && !stored(RenderChannel::Depth))
+    throw Error(info.root.string(), "cannot derive " + join(channel_names(depth_derived(info))) + ": the dataset has no depth");
   info.channels = requested;
   if (info.stored_at.empty()) info.stored_at.assign(info.resolutions.size(), info.stored);
   info.channels_at.clear();
-  for (const auto& here : info.stored_at) {
+  for (size_t r = 0; r < info.stored_at.size(); ++r) {
+    const auto& here = info.stored_at[r];
     auto has = [&](RenderChannel c) { return std::find(here.begin(), here.end(), c) != here.end(); };
     std::vector<RenderChannel> out;
     for (auto c : requested) {
       const bool derived = std::find(info.derived.begin(), info.derived.end(), c) != info.derived.end();
-      if (has(c) || (derived && has(RenderChannel::Depth))) out.push_back(c);
+      if (c == RenderChannel::Bsp ? bsp_available_at(info, r) : has(c) || (derived && has(RenderChannel::Depth)))
+        out.push_back(c);
     }
     info.channels_at.push_back(out);
   }
+}
+
+std::vector<RenderChannel> depth_derived(const DatasetInfo& info) {
+  std::vector<RenderChannel> out;
+  for (auto c : info.derived)
+    if (c != RenderChannel::Bsp) out.push_back(c);
+  return out;
 }
 
 const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t resolution) {
@@ -140,7 +167,8 @@ class CgsrDataset : public FrameSource {
     info_.near_plane = first.near_plane;
     info_.far_plane = first.far_plane;
     info_.vfov = first.vfov;
-    info_.stored = all_render_channels();
+    info_.stored = {RenderChannel::Depth, RenderChannel::Normal, RenderChannel::NormalAngle, RenderChannel::Edge,
+                    RenderChannel::Motion};  // every file channel; bsp is derived (bsp_channel.h)
     info_.split = manifest_.split;
     for (const auto& p : parts_)
       info_.scenes.push_back({p.name, p.first_frame, p.manifest.frames, p.manifest.near_plane, p.manifest.far_plane,
@@ -227,16 +255,30 @@ struct Dataset::Impl {
       if (std::find(info.stored_at[res].begin(), info.stored_at[res].end(), c) != info.stored_at[res].end())
         here.push_back(c);
     Frame f = source->load(index, res, here);
-    if (!info.derived.empty() && f.depth.defined()) {
+    const auto from_depth = depth_derived(info);
+    if (!from_depth.empty() && f.depth.defined()) {
       try {
-        derive_channels(f, info.derived, find_scene(info, index).vfov, options.edges);
+        derive_channels(f, from_depth, find_scene(info, index).vfov, options.edges);
       } catch (const Error& e) {
         throw Error(info.root.string(), "frame " + std::to_string(index) + ": " + e.message(), e.kind());
       }
       if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Depth) == info.channels.end())
         f.depth = torch::Tensor();
     }
+    if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Bsp) != info.channels.end() &&
+        bsp_available_at(info, res))
+      f.bsp = resolve_bsp(index, res, f);
     return f;
+  }
+
+  // The bsp channel of frame `index` at resolution `res`: the LR frame's BSP border image resolved
+  // over its colour (`f` itself at the BSP resolution; else the LR colour and tree files are read).
+  torch::Tensor resolve_bsp(int index, size_t res, const Frame& f) const {
+    const Frame lr = res == 0 ? Frame() : source->load(index, 0, {});
+    const Frame& base = res == 0 ? f : lr;
+    const std::string what = info.root.string() + ": frame " + std::to_string(index);
+    if (!base.bsp_border) throw Error(what, "has no sub-pixel BSP border image for the 'bsp' channel", ErrorKind::Internal);
+    return bsp_channel(base.color_float(), *base.bsp_border, info.resolutions[res].width / info.resolutions[0].width, what);
   }
 };
 
@@ -269,7 +311,7 @@ Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
   for (auto c : impl.info.channels)
     if (std::find(impl.info.derived.begin(), impl.info.derived.end(), c) == impl.info.derived.end())
       impl.load_channels.push_back(c);
-  if (!impl.info.derived.empty() &&
+  if (!depth_derived(impl.info).empty() &&
       std::find(impl.load_channels.begin(), impl.load_channels.end(), RenderChannel::Depth) == impl.load_channels.end())
     impl.load_channels.push_back(RenderChannel::Depth);
   std::sort(impl.load_channels.begin(), impl.load_channels.end());
@@ -334,6 +376,10 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
       needed.push_back(c);
   };
   for (auto c : channels) need(c);
+  // Kept when the data cannot give it, so that opening says what is missing and how to render it.
+  if (std::find(channels.begin(), channels.end(), RenderChannel::Bsp) != channels.end() &&
+      std::find(needed.begin(), needed.end(), RenderChannel::Bsp) == needed.end())
+    needed.push_back(RenderChannel::Bsp);
   need(RenderChannel::Edge);
   std::sort(needed.begin(), needed.end());
   DatasetOpenOptions open;

@@ -154,7 +154,15 @@ bool looks_like_glob_layout(const std::filesystem::path& path);
 
 // The channels that `options.channels` names (empty: all stored ones plus `derive`), checked
 // against what the data has and what can be derived; fills derived, channels and channels_at.
+// The bsp channel (render_channels.h) is derived on load when asked for (and by default when the
+// data set has BSP border files); asked for without them it is an error naming the data set and
+// how to render them.
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options);
+// info.derived without bsp: the channels derive_channels computes from depth.
+std::vector<RenderChannel> depth_derived(const DatasetInfo& info);
+// Whether `resolution` is an integer multiple of the BSP resolution (resolutions[0]) of a data set
+// with BSP border files: where the bsp channel exists.
+bool bsp_available_at(const DatasetInfo& info, size_t resolution);
 const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t resolution);
 
 }  // namespace cgsr

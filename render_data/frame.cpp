@@ -14,6 +14,7 @@ bool Frame::has(RenderChannel c) const {
     case RenderChannel::NormalAngle: return normal_angle.defined();
     case RenderChannel::Edge: return edge.defined();
     case RenderChannel::Motion: return motion.defined();
+    case RenderChannel::Bsp: return bsp.defined();
   }
   return false;
 }
@@ -38,6 +39,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
       case RenderChannel::NormalAngle: parts.push_back(normal_angle.to(torch::kFloat32)); break;
       case RenderChannel::Edge: parts.push_back(edge.to(torch::kFloat32)); break;
       case RenderChannel::Motion: parts.push_back(motion.to(torch::kFloat32)); break;
+      case RenderChannel::Bsp: parts.push_back(bsp); break;
     }
   }
   if (parts.empty()) return torch::zeros({0, height, width}, torch::kFloat32);
@@ -46,7 +48,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
 
 size_t Frame::bytes() const {
   size_t n = 0;
-  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion})
+  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp})
     if (t->defined()) n += t->numel() * t->element_size();
   if (bsp_border) n += bsp_border->bytes();
   return n;
@@ -61,7 +63,8 @@ Frame crop(const Frame& f, int x, int y, int w, int h) {
   const Frame* src = &f;
   for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
                            std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},
-                           std::pair{&out.edge, &src->edge}, std::pair{&out.motion, &src->motion}})
+                           std::pair{&out.edge, &src->edge}, std::pair{&out.motion, &src->motion},
+                           std::pair{&out.bsp, &src->bsp}})
     if (from->defined()) *dst = from->slice(1, y, y + h).slice(2, x, x + w);
   return out;
 }

@@ -27,6 +27,10 @@ struct Frame {
   torch::Tensor normal_angle;  // float16 [1,H,W] in [0,1]
   torch::Tensor edge;          // uint8 [1,H,W], 0 or 1
   torch::Tensor motion;        // float32 [2,H,W], pixels (render_channels.h)
+  // float32 [4,H,W]: the BSP border image resolved at this resolution (render_channels.h, derived
+  // on load from the LR frame's colour and bsp_border; bsp_channel.h). float32: it is the BSP
+  // upsampler's output number for number.
+  torch::Tensor bsp;
   DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
   // The sub-pixel BSP border image, when the data set stores one at this resolution (cgsr data
   // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <iterator>
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -152,9 +153,10 @@ class GlobDataset : public FrameSource {
         return true;
       };
       collect(r.color, rf.color, "color");
+      // The stored channels, in the fixed order (bsp is made from a cgsr data set's BSP files only).
       const std::string* patterns[] = {&r.depth, &r.normal, &r.normal_angle, &r.edge, &r.motion};
       std::vector<RenderChannel> here;
-      for (size_t c = 0; c < all_render_channels().size(); ++c)
+      for (size_t c = 0; c < std::size(patterns); ++c)
         if (collect(*patterns[c], rf.files[c], channel_name(all_render_channels()[c]))) {
           present[c] = true;
           here.push_back(all_render_channels()[c]);
@@ -236,6 +238,7 @@ class GlobDataset : public FrameSource {
         case RenderChannel::Motion:
           f.motion = decode(file(c), "motion", [&](const ImageFile& image) { return decode_capture_motion(image, motion_format_); });
           break;
+        case RenderChannel::Bsp: break;  // never stored: resolve_channels only derives it
       }
     }
     return f;

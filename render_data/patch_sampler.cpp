@@ -71,6 +71,8 @@ Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int
   if (color) {
     it.lr_color = augment_color(it.lr_color, *color);
     it.hr_color = augment_color(it.hr_color, *color);
+    it.lr_info = augment_info_color(it.lr_info, channels, *color);
+    it.hr_info = augment_info_color(it.hr_info, channels, *color);
   }
   return it;
 }

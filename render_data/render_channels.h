@@ -24,6 +24,14 @@
 //                                 Motion excludes the sub-pixel jitter (jitter.h, the FSR 2
 //                                 convention): both positions are the unjittered ones, so a still
 //                                 camera over a static scene has motion 0 although the samples move
+//   bsp             4    [0,1]    the sub-pixel BSP border image (bsp_border.h) resolved at this
+//                                 resolution: (r, g, b) the BSP border upsampler's output from the
+//                                 LR colour (sRGB-encoded like the colour image), then coverage, 1
+//                                 where the pixel's centre lies in an LR pixel that has a tree.
+//                                 Derived on load (bsp_channel.h) at every resolution that is an
+//                                 integer multiple of the data set's BSP resolution (at that one:
+//                                 the colour with each border pixel's centre leaf); only cgsr data
+//                                 sets rendered with bsp_border have it
 
 #include <torch/types.h>
 
@@ -34,7 +42,7 @@
 
 namespace cgsr {
 
-enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion };
+enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp };
 
 const std::vector<RenderChannel>& all_render_channels();  // in the fixed order above
 const std::string& channel_name(RenderChannel channel);

@@ -1,6 +1,7 @@
 #pragma once
 // The BSP border upsampler: a classic baseline that reads the renderer's sub-pixel BSP border
-// images (render_data/bsp_border.h). An output pixel whose centre falls in a border pixel of the
+// images (render_data/bsp_border.h) and resolves them at the output size with
+// render_data/bsp_channel.h (the `bsp` rendering channel's code). An output pixel whose centre falls in a border pixel of the
 // input takes the colour of the leaf its centre falls in, so the edge stays where the geometry
 // put it; every other output pixel is the bicubic interpolation of the input (interpolation.h,
 // the same pixel-centre convention), except that a tap on a border pixel reads that pixel's leaf

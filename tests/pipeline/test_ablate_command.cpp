@@ -74,3 +74,40 @@ TEST(Ablation, TrainsEveryVariantAgainstTheControlAndResumes) {
             std::string::npos);
   fs::remove_all(dir);
 }
+
+// channel_sets: each list of channels at the best source, named after it, here with the bsp
+// channel of a data set rendered with BSP border files; a set naming no channel or an unknown one
+// is refused before anything trains.
+TEST(Ablation, ChannelSetsTrainTheBestSourceWithOtherChannels) {
+  const auto dir = scratch_dir("ablation-channel-sets");
+  const auto render = run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) +
+                               "/configs/scenes/tiny.yaml --set frames=3 --set bsp_border.depth=2 --threads 1 --out " +
+                               (dir / "data").string());
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  save_model(dir / "plain.cgsr", *SRNetwork(default_spec("pan", 2)));
+  const std::string command =
+      "ablate --data " + (dir / "data").string() + " --model " + (dir / "plain.cgsr").string() +
+      " --threads 1 --set ablation.sources=[hr_fuse] --set ablation.seeds=[1] --set ablation.leave_out=false"
+      " --set ablation.rit.channels=[depth,edge] --set ablation.small_width=0 --set ablation.schedule.steps=2"
+      " --set ablation.schedule.batch_size=2 --set ablation.schedule.patch_size=16"
+      " --set ablation.schedule.validate_every=0 --set ablation.schedule.val_frames=1"
+      " --set ablation.schedule.layout=nchw --set ablation.eval.latency_runs=0 --set ablation.eval.split=all";
+  const auto r = run_cgsr(command + " --set 'ablation.channel_sets=[[bsp], [edge, depth, bsp]]' --out " +
+                          (dir / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(read_file(dir / "run" / "results.json")).at("rows");
+  ASSERT_EQ(rows.size(), 4u) << rows;
+  EXPECT_EQ(rows[2].at("variant"), "hr_fuse [bsp]");
+  EXPECT_EQ(rows[3].at("variant"), "hr_fuse [depth+edge+bsp]");  // the channels in their fixed order
+  EXPECT_EQ(rows[2].at("kind"), "channels");
+  EXPECT_NE(rows[3].at("spec").get<std::string>().find("rit[depth+edge+bsp"), std::string::npos) << rows[3];
+  // The bsp channel's 4 inputs: more parameters than the same RIT without it would have.
+  EXPECT_GT(rows[3].at("params").get<int64_t>(), rows[1].at("params").get<int64_t>());
+
+  for (const char* bad : {"[[]]", "[[depht]]"}) {
+    const auto refused = run_cgsr(command + " --set 'ablation.channel_sets=" + bad + "' --out " + (dir / "bad").string());
+    EXPECT_EQ(refused.exit_code, 2) << bad << refused.all();
+    EXPECT_NE(refused.all().find("channel_sets"), std::string::npos) << refused.all();
+  }
+  fs::remove_all(dir);
+}
