@@ -153,8 +153,9 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   }
   if (spec.rit.enabled && spec.rit.channels.empty())
     problems.push_back({"rit.channels", "an enabled RIT needs at least one rendering channel"});
+  std::vector<RenderChannel> rit_channels;
   try {
-    parse_channels(spec.rit.channels);
+    rit_channels = parse_channels(spec.rit.channels);
   } catch (const Error& e) {
     problems.push_back({"rit.channels", e.message()});
   }
@@ -162,6 +163,18 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", config::out_of_range(spec.rit.hr_width, 1, config::kUnbounded)});
+  if (spec.rit.bsp_composite) {
+    // The composite reads the bsp channel's colour and coverage at the output resolution.
+    const std::vector<std::string> hr_sources(rit_sources().begin() + 1, rit_sources().end());  // lr is the first
+    if (!spec.rit.enabled)
+      problems.push_back({"rit.bsp_composite", "composites the output with the RIT's bsp channel; enable rit"});
+    else if (std::find(rit_channels.begin(), rit_channels.end(), RenderChannel::Bsp) == rit_channels.end())
+      problems.push_back({"rit.bsp_composite", "composites the output with the bsp channel, which rit.channels [" +
+                                                   join(spec.rit.channels) + "] does not list: add bsp"});
+    else if (!spec.rit.reads_hr())
+      problems.push_back({"rit.bsp_composite", "needs the bsp channel at the output resolution, which rit.source lr "
+                                               "does not give: use " + join(hr_sources, ", or ")});
+  }
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -235,6 +248,10 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("hr_width", &RitSpec::hr_width, "features of the HR branch (hr_fuse)").at_least(1);
   rit.field("fusion", &RitSpec::fusion, "how RIT features join the backbone");
   rit.field("depth_encoding", &RitSpec::depth_encoding, "how depth is encoded for the network");
+  rit.field("bsp_composite", &RitSpec::bsp_composite,
+            "output the bsp channel's image on the pixels its coverage marks, the network's elsewhere");
+  // Written only when set, so specs and stage hashes from before the option read the same.
+  rit.omit_when("bsp_composite", [](const RitSpec& r) { return !r.bsp_composite; });
   return rit;
 }
 
@@ -300,7 +317,7 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
-         " depth]";
+         " depth" + (r.bsp_composite ? ", bsp composite" : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

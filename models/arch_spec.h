@@ -22,6 +22,8 @@
 //     hr_width: 16           # features of the HR branch (hr_fuse; layer group "rit_hr")
 //     fusion: concat         # concat (feat + 1x1(cat(feat, rit))), or add (feat + 1x1(rit))
 //     depth_encoding: log    # log, linear or zbuffer (render_channels.h DepthEncoding)
+//     bsp_composite: false   # the output is the bsp channel's image where its coverage is 1,
+//                            #   the network's elsewhere (needs bsp among channels, an HR source)
 //   geometry:                # training-only head predicting the HR rendering information
 //     enabled: true
 //     width: 16
@@ -101,6 +103,10 @@ struct RitSpec {
   int hr_width = 16;              // features of the HR branch (layer group "rit_hr")
   RitFusion fusion = RitFusion::Concat;
   DepthEncoding depth_encoding = DepthEncoding::Log;  // log, linear or zbuffer in YAML
+  // The network's image composited with the bsp channel at HR (rit.h): out = (1 - m) * net + m *
+  // bsp_rgb, m the channel's coverage. Where the renderer resolved the border (the BSP leaves) the
+  // output is its image exactly; the network learns the rest.
+  bool bsp_composite = false;
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
@@ -113,7 +119,8 @@ struct RitSpec {
   bool reads_hr() const { return source != RitSource::Lr; }
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
-           hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding;
+           hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding &&
+           bsp_composite == o.bsp_composite;
   }
 };
 

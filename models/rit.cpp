@@ -47,6 +47,23 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     hr_conv = register_module("hr_conv", make_conv(c, rit.hr_width, 3));
     hr_fuse = register_module("hr_fuse", make_fusion(concat_, hr_features.channels, rit.hr_width));
   }
+  if (rit.bsp_composite) {
+    CGSR_CHECK(info_factor_ == scale, "RIT: bsp_composite needs the information at the output resolution");
+    int64_t offset = 0;  // the bsp channel's first position in the info input
+    for (auto channel : rit.render_channels()) {
+      if (channel == RenderChannel::Bsp) break;
+      offset += channel_width(channel);
+    }
+    CGSR_CHECK(offset < c, "RIT: bsp_composite needs the bsp channel");
+    bsp_color_ = torch::zeros({3, c, 1, 1});
+    bsp_coverage_ = torch::zeros({3, c, 1, 1});
+    for (int64_t k = 0; k < 3; ++k) {
+      bsp_color_[k][offset + k] = 1.0f;
+      bsp_coverage_[k][offset + 3] = 1.0f;
+    }
+    complement_scale_ = torch::full({3}, -1.0f);
+    complement_shift_ = torch::full({3}, 1.0f);
+  }
 }
 
 torch::Tensor RitBlockImpl::gate_info(const torch::Tensor& info) const {
@@ -92,6 +109,21 @@ int RitBlockImpl::describe_hr(graph::Builder& g, int hr_features, int gated) con
   const int x = g.leaky_relu(
       describe_conv(g, "hr_conv", hr_conv, gated, graph::group_layout("rit_hr", hr_conv->weight.size(0))), kLeakySlope);
   return describe_join(g, "hr_fuse", hr_fuse, hr_features, x);
+}
+
+torch::Tensor RitBlockImpl::composite_bsp(const torch::Tensor& image, const torch::Tensor& info) const {
+  // The kernels and the operand order of describe_composite_bsp(), so both give the same bits.
+  const auto covered = torch::conv2d(info, bsp_coverage_);
+  const auto kept = graph::apply_affine(covered, complement_scale_, complement_shift_);
+  return kept * image + covered * torch::conv2d(info, bsp_color_);
+}
+
+int RitBlockImpl::describe_composite_bsp(graph::Builder& g, int image, int info) const {
+  const auto rgb = g.value(image).layout;
+  const int covered = g.conv("bsp_coverage", info, bsp_coverage_, {}, 0, rgb, /*trainable=*/false);
+  const int kept = g.affine("bsp_complement", covered, complement_scale_, complement_shift_, /*trainable=*/false);
+  const int bsp = g.conv("bsp_color", info, bsp_color_, {}, 0, rgb, /*trainable=*/false);
+  return g.add(g.mul(kept, image), g.mul(covered, bsp));
 }
 
 }  // namespace cgsr

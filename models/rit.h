@@ -23,6 +23,15 @@
 //
 // Every fusion conv starts at zero, so a network with a fresh RIT computes exactly what its
 // backbone computes (x + 0 == x), and training starts from the pretrained behaviour.
+//
+// rit.bsp_composite: the network's image is composited with the bsp channel read from the raw
+// (ungated) HR input: out = (1 - m) * net + m * bsp_rgb, m the channel's coverage (1 on the pixels
+// whose centre lies in an LR border pixel, where the renderer resolved the edge into BSP leaves).
+// The networks learn little of copying the leaves (docs/results/bsp_rit.md), so they are given
+// them; training's loss is on the composite, so the network learns the other pixels. Written
+// with fixed 0/1 1x1 convs that pick the colour and the coverage (broadcast to 3 channels) out of
+// the info input, a ChannelAffine for 1 - m, Mul and Add: every runtime runs it, and as m is 0 or
+// 1 the result is exactly bsp_rgb or net (0 * x + y == y), not net + (bsp - net) rounded.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/conv.h>
@@ -56,6 +65,10 @@ class RitBlockImpl : public torch::nn::Module {
   int describe_gate(graph::Builder& g, int info) const;
   int describe_features(graph::Builder& g, int features, int gated) const;
   int describe_hr(graph::Builder& g, int hr_features, int gated) const;
+  // rit.bsp_composite: the image composited with the bsp channel of `info` (the raw HR input).
+  bool composites_bsp() const { return bsp_color_.defined(); }
+  torch::Tensor composite_bsp(const torch::Tensor& image, const torch::Tensor& info) const;
+  int describe_composite_bsp(graph::Builder& g, int image, int info) const;
 
   bool has_feature_branch() const { return !conv.is_empty(); }
   bool has_hr_branch() const { return !hr_conv.is_empty(); }
@@ -79,6 +92,9 @@ class RitBlockImpl : public torch::nn::Module {
   int64_t pool_factor_;      // hr_pooled: the scale
   int64_t stride_;           // hr_unshuffle: the scale
   int64_t upsample_factor_;  // the feature map's factor
+  // bsp_composite: constants (no parameters, not in model files), [3, C, 1, 1] 0/1 selections of
+  // the bsp colour and of its coverage for each of R, G, B; and 1 - m as scale -1, shift 1.
+  torch::Tensor bsp_color_, bsp_coverage_, complement_scale_, complement_shift_;
 };
 TORCH_MODULE(RitBlock);
 

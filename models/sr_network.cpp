@@ -53,7 +53,10 @@ Reconstruction SRNetworkImpl::run(const torch::Tensor& lr_color, const torch::Te
   const auto features = rit_->has_feature_branch() ? rit_->fuse_features(extracted.features, gated) : extracted.features;
   HrFusion at_hr;
   if (rit_->has_hr_branch()) at_hr = [&](const torch::Tensor& hr) { return rit_->fuse_hr(hr, gated); };
-  return backbone_->reconstruct(features, extracted.skip, at_hr);
+  auto recon = backbone_->reconstruct(features, extracted.skip, at_hr);
+  // Last, on the image every caller sees (training's loss too), from the ungated input.
+  if (rit_->composites_bsp()) recon.image = rit_->composite_bsp(recon.image, info);
+  return recon;
 }
 
 torch::Tensor SRNetworkImpl::forward(const torch::Tensor& lr_color, const torch::Tensor& info) {
@@ -125,6 +128,10 @@ graph::Graph SRNetworkImpl::describe_graph(bool training) const {
   {
     auto scope = g.scope("backbone");
     recon = backbone_->describe_reconstruct(g, features, extracted.skip, at_hr);
+  }
+  if (has_rit() && rit_->composites_bsp()) {
+    auto scope = g.scope("rit");
+    recon.image = rit_->describe_composite_bsp(g, recon.image, info);
   }
   g.output("image", recon.image);
   if (training && has_geometry_head()) {

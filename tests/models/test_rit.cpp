@@ -220,3 +220,60 @@ TEST(Rit, BatchesInAnotherDepthEncodingAreRefused) {
   SRNetwork edges(resolve_spec(no_depth));
   EXPECT_NO_THROW(edges->info_input(batch));
 }
+
+// rit.bsp_composite over every backbone, scale and HR source: the output is the bsp channel's
+// colour, bit for bit, on the pixels its coverage marks, and the same network without the option
+// elsewhere; the graph computes what forward() does; the covered pixels give the network no
+// gradient (training learns the rest).
+TEST(Rit, BspCompositeIsTheBspImageWhereCoveredAndTheNetworkElsewhere) {
+  torch::manual_seed(23);
+  for (const auto& c : all_backbone_cases())
+    for (const auto& source : rit_sources_for(c.backbone)) {
+      if (source == "lr") continue;
+      SCOPED_TRACE(case_name(c) + " " + source);
+      ArchSpec plain_spec = with_rit(spec_for(c), source);
+      plain_spec.rit.channels = {"edge", "bsp"};  // bsp at positions 1..4: the selection's offset counts
+      plain_spec = resolve_spec(plain_spec);
+      ArchSpec spec = plain_spec;
+      spec.rit.bsp_composite = true;
+      SRNetwork plain(plain_spec), net(resolve_spec(spec));
+      randomize_fusion(*plain, 0.1);
+      {
+        torch::NoGradGuard no_grad;
+        auto theirs = plain->named_parameters();
+        for (auto& p : net->named_parameters()) p.value().copy_(theirs[p.key()]);
+      }
+      auto [color, info] = random_inputs(spec, 7, 5);
+      info.select(1, 4).copy_(torch::rand_like(info.select(1, 4)).gt(0.6));  // coverage: 0 or 1
+      const auto covered = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).to(torch::kBool);
+      const auto bsp = info.slice(1, 1, 4);
+      ASSERT_GT(covered.sum().item<int64_t>(), 0);
+      ASSERT_GT((~covered).sum().item<int64_t>(), 0);
+      {
+        torch::NoGradGuard no_grad;
+        const auto out = net->forward(color, info), theirs = plain->forward(color, info);
+        EXPECT_TRUE(torch::equal(out.masked_select(covered), bsp.masked_select(covered)));
+        EXPECT_TRUE(torch::equal(out.masked_select(~covered), theirs.masked_select(~covered)));
+        EXPECT_FALSE(torch::equal(out, theirs));
+      }
+      // The interpreter runs the composite as forward() does, in the deployed graph too.
+      {
+        torch::NoGradGuard no_grad;
+        const auto g = net->describe(/*training=*/true);
+        const auto image = graph::run(g, network_inputs(g, color, info)).front().second;
+        EXPECT_TRUE(torch::equal(image, net->forward_train(color, info).image));
+        const auto deployed = net->describe(/*training=*/false);
+        EXPECT_NE(deployed.find_op("rit.bsp_color"), nullptr);
+        const auto served = graph::run(deployed, network_inputs(deployed, color, info)).front().second;
+        EXPECT_TRUE(torch::equal(served.masked_select(covered), bsp.masked_select(covered)));
+      }
+      // A loss on the covered pixels only reaches no parameter.
+      net->zero_grad();
+      net->forward_train(color, info).image.masked_select(covered).sum().backward();
+      for (const auto& p : net->parameters())
+        if (p.grad().defined()) EXPECT_EQ(p.grad().abs().max().item<float>(), 0.f);
+      // The composite holds no parameters: the model file and the parameter count are unchanged.
+      EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
+      EXPECT_EQ(inference_parameter_count(*net), inference_parameter_count(*plain));
+    }
+}
