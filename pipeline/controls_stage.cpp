@@ -31,7 +31,7 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
   results["target_latency_ms"] = target;
   results["controls"] = nlohmann::ordered_json::array();
   for (const ControlKind kind : job.options.kinds) {
-    ControlNetwork control = control_at_latency(*enhanced.network, kind, target, lr.width, lr.height);
+    ControlNetwork control = control_at_latency(*enhanced.network, kind, target, measured_latency(lr.width, lr.height));
     const std::string name = base + " " + control_label(kind);
     const std::string stem = enum_name(kind);
     spdlog::info("{}: keep rate {:.3f}, {:.1f} ms; fine-tuning {} steps", name, control.rate, control.latency_ms,
