@@ -175,6 +175,21 @@ class CgsrDataset : public FrameSource {
                               p.manifest.vfov, p.weight});
     info_.bsp_border = std::all_of(parts_.begin(), parts_.end(),
                                    [](const ScenePart& p) { return p.manifest.bsp_border_depth > 0; });
+    // One target for the set, or each scene's named (a merge of aliased and supersampled scenes).
+    std::vector<std::string> targets;
+    for (const auto& p : parts_) {
+      const std::string t = hr_target_description(p.manifest.hr_samples, p.manifest.hr_filter);
+      if (std::find(targets.begin(), targets.end(), t) == targets.end()) targets.push_back(t);
+    }
+    info_.hr_samples = targets.size() == 1 ? first.hr_samples : 0;
+    if (targets.size() == 1) {
+      info_.target = targets.front();
+    } else {
+      info_.target = "mixed:";
+      for (const auto& p : parts_)
+        info_.target += (&p == &parts_.front() ? " " : ", ") + p.name + " " +
+                        hr_target_description(p.manifest.hr_samples, p.manifest.hr_filter);
+    }
   }
   const DatasetInfo& info() const override { return info_; }
   Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {

@@ -26,6 +26,7 @@
 #include "render_data/dataset_manifest.h"
 #include "render_data/edges.h"
 #include "render_data/frame.h"
+#include "render_data/hr_samples.h"
 
 namespace cgsr {
 
@@ -84,6 +85,11 @@ struct DatasetInfo {
   // Every frame has a sub-pixel BSP border image at resolutions[0] (Frame::bsp_border; cgsr data
   // sets rendered with bsp_border).
   bool bsp_border = false;
+  // What the frames above the smallest resolution show, the ground truth the reports name: a cgsr
+  // render's hr_samples (hr_samples.h; 0 for anything else) and its description, e.g.
+  // "supersampled (4 samples per pixel, box filter)"; captures are taken as they come.
+  int hr_samples = 0;
+  std::string target = kCapturedTarget;
 };
 
 // What a layout implements: metadata, and one frame at one resolution with the given channels
