@@ -62,6 +62,9 @@ struct SceneInfo {
   int first_frame = 0, frames = 0;
   double near_plane = 0.05, far_plane = 500, vfov = 60;  // the depth planes and FOV of its frames
   double weight = 0;  // sampling weight; 0 for every scene: proportional to its training frames
+  // Its ground truth (DatasetInfo::hr_samples, target): what a one-scene view of a set names.
+  int hr_samples = 0;
+  std::string target = kCapturedTarget;
   bool contains(int frame) const { return frame >= first_frame && frame < first_frame + frames; }
 };
 

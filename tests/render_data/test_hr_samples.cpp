@@ -123,7 +123,9 @@ TEST(HrSamples, OnlyPixelsAtGeometryEdgesChange) {
 // fingerprint, no manifest key, the same bytes as render().
 TEST(HrSamples, SupersamplingChangesOnlyTheTargetsColour) {
   const fs::path root = test::temp_dir("hr_samples_render");
-  const RenderJobOptions one = hr_tiny_job(2, 1), four = hr_tiny_job(2, 4);
+  RenderJobOptions one = hr_tiny_job(2, 1), four = hr_tiny_job(2, 4);
+  one.name = "one";
+  four.name = "four";
   RenderJobOptions plain = hr_tiny_job(2, 1);
   EXPECT_EQ(render_fingerprint(one, 1), render_fingerprint(plain, 1));
   EXPECT_NE(render_fingerprint(four, 1), render_fingerprint(one, 1));
@@ -174,6 +176,14 @@ TEST(HrSamples, SupersamplingChangesOnlyTheTargetsColour) {
   EXPECT_EQ(Dataset::open(root / "four").info().hr_samples, 4);
   EXPECT_EQ(Dataset::open(root / "one").info().target, "aliased (1 sample per pixel)");
   EXPECT_EQ(Dataset::open(root / "one").info().hr_samples, 1);
+  // A set merged from both names each scene's target, and a view of one scene its own.
+  write_manifest(root / "mixed", merge_manifests(root / "mixed", "mixed", {root / "one", root / "four"}, {}));
+  const Dataset mixed = Dataset::open(root / "mixed");
+  EXPECT_EQ(mixed.info().target,
+            "mixed: one aliased (1 sample per pixel), four supersampled (4 samples per pixel, box filter)");
+  EXPECT_EQ(mixed.info().hr_samples, 0);
+  EXPECT_EQ(mixed.scene("four").info().target, "supersampled (4 samples per pixel, box filter)");
+  EXPECT_EQ(mixed.scene("one").info().hr_samples, 1);
   try {
     run_render_job(four, 1, root / "one");
     ADD_FAILURE() << "resumed an aliased render with hr_samples 4";
