@@ -174,6 +174,7 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   result.name = upscaler.name();
   result.precision = upscaler.precision();
   result.dataset = data.info().name;
+  result.target = data.info().target;
   result.split = options.split;
   result.scale = upscaler.scale();
   const auto [lr_resolution, hr_resolution] = resolution_pair(data, result.scale);
@@ -381,6 +382,7 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
   j["name"] = r.name;
   if (r.precision != Precision::Fp32) j["precision"] = enum_name(r.precision);
   j["dataset"] = r.dataset;
+  j["target"] = r.target;
   j["split"] = r.split;
   j["scale"] = r.scale;
   j["lr_width"] = r.lr_width;
@@ -427,6 +429,7 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
     r.name = j.at("name");
     if (j.contains("precision")) r.precision = enum_from_name<Precision>(j.at("precision").get<std::string>());
     r.dataset = j.at("dataset");
+    r.target = j.value("target", "");  // results from before the field
     r.split = j.at("split");
     r.scale = j.at("scale");
     r.lr_width = j.at("lr_width");

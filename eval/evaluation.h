@@ -50,6 +50,9 @@ struct EvalResult {
   std::string name;
   Precision precision = Precision::Fp32;  // of a network's row ("<network> int8")
   std::string dataset;  // the data set's scene name
+  // The ground truth measured against (DatasetInfo::target): "aliased (1 sample per pixel)",
+  // "supersampled (4 samples per pixel, box filter)", "as captured"; empty in older results.
+  std::string target;
   std::string split;
   int scale = 2;
   int64_t lr_width = 0, lr_height = 0;

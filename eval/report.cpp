@@ -74,9 +74,11 @@ std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
   std::vector<ReportTable> tables;
   for (const auto& r : results) {
     auto it = std::find_if(tables.begin(), tables.end(),
-                           [&](const ReportTable& t) { return t.dataset == r.dataset && t.scale == r.scale; });
+                           [&](const ReportTable& t) {
+                             return t.dataset == r.dataset && t.scale == r.scale && t.target == r.target;
+                           });
     if (it == tables.end()) {
-      tables.push_back({r.dataset, r.scale, {}});
+      tables.push_back({r.dataset, r.scale, {}, r.target});
       it = tables.end() - 1;
     }
     it->rows.push_back(r);
@@ -103,6 +105,7 @@ std::string report_markdown(const ReportTable& table) {
   const auto& first = table.rows.front();
   md << "### " << table.dataset << " x" << table.scale << " (" << first.split << " split, " << first.frames.size()
      << " frames, LR " << first.lr_width << "x" << first.lr_height << ")\n\n";
+  if (!table.target.empty()) md << "Target: " << table.target << ".\n\n";
   const auto columns = report_columns(table);
   md << "| Model |";
   for (const auto& c : columns) md << " " << c << " |";
@@ -142,7 +145,7 @@ std::string report_markdown(const ReportTable& table) {
 std::string report_csv(const std::vector<ReportTable>& tables) {
   std::ostringstream csv;
   csv << "dataset,scale,model,params,macs,latency_ms,psnr,ssim,temporal_error,temporal_error_reference,frames,"
-         "onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n";
+         "onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction,target\n";
   for (const auto& t : tables)
     for (const auto& r : t.rows) {
       csv << csv_field(t.dataset) << "," << t.scale << "," << csv_field(r.name) << ","
@@ -153,7 +156,7 @@ std::string report_csv(const std::vector<ReportTable>& tables) {
           << (r.temporal_error_reference ? fixed(*r.temporal_error_reference, 6) : "") << "," << r.frames.size() << ","
           << (r.onnxruntime_latency ? fixed(r.onnxruntime_latency->median_ms, 4) : "") << ","
           << optional_fixed(r.psnr_edge, 4, "") << "," << optional_fixed(r.psnr_rest, 4, "") << ","
-          << optional_fixed(r.edge_fraction, 6, "") << "\n";
+          << optional_fixed(r.edge_fraction, 6, "") << "," << csv_field(t.target) << "\n";
     }
   return csv.str();
 }
@@ -227,7 +230,12 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
     canvas->save(run_dir.file(stem + ".png"));
     canvas->save(run_dir.file(stem + ".svg"));
   };
-  for (const auto& t : tables) {
+  for (size_t ti = 0; ti < tables.size(); ++ti) {
+    const ReportTable& t = tables[ti];
+    // A scene and scale measured against another target too has tables of its own: "_2" and on.
+    const auto same = std::count_if(tables.begin(), tables.begin() + static_cast<std::ptrdiff_t>(ti),
+                                    [&](const ReportTable& o) { return o.dataset == t.dataset && o.scale == t.scale; });
+    const std::string stem = t.dataset + "_x" + std::to_string(t.scale) + (same ? "_" + std::to_string(same + 1) : "");
     const bool heldout = std::find(heldout_scenes.begin(), heldout_scenes.end(), t.dataset) != heldout_scenes.end();
     if (heldout)
       markdown += "## Held-out scene: " + t.dataset +
@@ -237,12 +245,13 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
     // A plot of PSNR against latency needs a latency (held-out scenes are evaluated for quality only).
     std::string plot;
     if (std::any_of(t.rows.begin(), t.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); })) {
-      plot = "plot_" + t.dataset + "_x" + std::to_string(t.scale);
+      plot = "plot_" + stem;
       save_plot(plot, report_plot(t, roles));
       markdown += "![PSNR against latency](" + plot + ".png)\n\n";
     }
     results["tables"].push_back({{"dataset", t.dataset},
                                  {"scale", t.scale},
+                                 {"target", t.target},
                                  {"rows", t.rows.size()},
                                  {"plot", plot.empty() ? "" : plot + ".png"},
                                  {"plot_svg", plot.empty() ? "" : plot + ".svg"},
@@ -251,7 +260,7 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
     for (size_t i = 0; i < t.rows.size(); ++i) {
       const auto choices = pattern_choices(t.rows[i]);
       if (!choices) continue;
-      std::string choice_plot = "pattern_choice_" + t.dataset + "_x" + std::to_string(t.scale) + "_" + std::to_string(i + 1);
+      std::string choice_plot = "pattern_choice_" + stem + "_" + std::to_string(i + 1);
       const bool has_edges = std::any_of(choices->frames.begin(), choices->frames.end(),
                                          [](const FrameChoice& c) { return c.edge_fraction.has_value(); });
       if (has_edges)
@@ -261,6 +270,7 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
       markdown += pattern_choice_markdown(t.rows[i].name, *choices, choice_plot.empty() ? "" : choice_plot + ".png");
       results["pattern_choices"].push_back({{"dataset", t.dataset},
                                             {"scale", t.scale},
+                                            {"target", t.target},
                                             {"model", t.rows[i].name},
                                             {"patterns_used", choices->usage.size()},
                                             {"plot", choice_plot.empty() ? "" : choice_plot + ".png"},

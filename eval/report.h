@@ -25,9 +25,11 @@ struct ReportTable {
   std::string dataset;
   int scale = 2;
   std::vector<EvalResult> rows;  // in the order given
+  std::string target;            // the ground truth its rows measure against (EvalResult::target)
 };
 
-// Groups results by (dataset, scale), keeping their order within each group.
+// Groups results by (dataset, scale, target), keeping their order within each group: a scene
+// rendered aliased and supersampled is two tables.
 std::vector<ReportTable> group_results(const std::vector<EvalResult>& results);
 
 // The columns of a table after the model's name: latency only when some row was timed, ONNX

@@ -163,17 +163,22 @@ void write_report_page(const std::filesystem::path& dir, const nlohmann::ordered
     const auto& first = table.rows.front();
     const nlohmann::ordered_json* meta = nullptr;
     for (const auto& m : table_meta)
-      if (m.value("dataset", "") == table.dataset && m.value("scale", 0) == table.scale) meta = &m;
+      if (m.value("dataset", "") == table.dataset && m.value("scale", 0) == table.scale &&
+          m.value("target", "") == table.target)
+        meta = &m;
     const bool heldout = meta && meta->value("heldout", false);
     h << "<h2 id=\"table" << t << "\">" << (heldout ? "Held-out scene: " : "") << html_escape(table.dataset) << " x"
       << table.scale << "</h2>\n<p class=\"note\">" << html_escape(first.split) << " split, " << first.frames.size()
       << " frames, LR " << first.lr_width << "x" << first.lr_height
-      << (heldout ? "; not in the training data: quality only, latency is in the run's own table" : "") << ".</p>\n"
+      << (heldout ? "; not in the training data: quality only, latency is in the run's own table" : "")
+      << (table.target.empty() ? "" : "; target: " + html_escape(table.target)) << ".</p>\n"
       << table_html(table);
     if (meta && !meta->value("plot_svg", "").empty())
       h << "<img src=\"" << html_escape(meta->value("plot_svg", "")) << "\" alt=\"PSNR against latency\">\n";
     for (const auto& e : choice_meta) {
-      if (e.value("dataset", "") != table.dataset || e.value("scale", 0) != table.scale) continue;
+      if (e.value("dataset", "") != table.dataset || e.value("scale", 0) != table.scale ||
+          e.value("target", "") != table.target)
+        continue;
       const auto row = std::find_if(table.rows.begin(), table.rows.end(),
                                     [&](const EvalResult& r) { return r.name == e.value("model", ""); });
       if (row == table.rows.end()) continue;

@@ -143,6 +143,8 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   std::vector<EvalResult> results;
   nlohmann::ordered_json json;
   json["data"] = data.info().root.string();
+  json["target"] = data.info().target;  // the ground truth every evaluation below measures against
+  spdlog::info("{}: target {}", data.info().root.string(), data.info().target);
   if (!options.scene.empty()) json["scene"] = options.scene;
   json["evaluations"] = nlohmann::ordered_json::array();
   // Each model's figures are written as soon as its quality is known: at 1080p the latency of the

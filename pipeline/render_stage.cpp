@@ -181,6 +181,7 @@ Rendered render_one_scene(const RenderOptions& options, const std::filesystem::p
   progress.finish();
   nlohmann::ordered_json j = render_summary(out, r.manifest, r.rendered, r.skipped, r.seconds);
   j["triangles"] = r.triangles;
+  j["target"] = hr_target_description(r.manifest.hr_samples, r.manifest.hr_filter);
   j["bytes_per_frame"] = sizes_json(r);
   j["motion_rejected"] = motion_rejected_json(r);
   if (r.manifest.bsp_border_depth > 0) j["bsp_border"] = bsp_border_json(r);

@@ -172,9 +172,17 @@ class CgsrDataset : public FrameSource {
     info_.split = manifest_.split;
     for (const auto& p : parts_)
       info_.scenes.push_back({p.name, p.first_frame, p.manifest.frames, p.manifest.near_plane, p.manifest.far_plane,
-                              p.manifest.vfov, p.weight});
+                              p.manifest.vfov, p.weight, p.manifest.hr_samples,
+                              hr_target_description(p.manifest.hr_samples, p.manifest.hr_filter)});
     info_.bsp_border = std::all_of(parts_.begin(), parts_.end(),
                                    [](const ScenePart& p) { return p.manifest.bsp_border_depth > 0; });
+    // One target for the set, or each scene's named (a merge of aliased and supersampled scenes).
+    const bool one_target = std::all_of(info_.scenes.begin(), info_.scenes.end(),
+                                        [&](const SceneInfo& s) { return s.target == info_.scenes.front().target; });
+    info_.hr_samples = one_target ? info_.scenes.front().hr_samples : 0;
+    info_.target = one_target ? info_.scenes.front().target : "mixed:";
+    if (!one_target)
+      for (const auto& s : info_.scenes) info_.target += (&s == &info_.scenes.front() ? " " : ", ") + s.name + " " + s.target;
   }
   const DatasetInfo& info() const override { return info_; }
   Frame load(int frame, size_t res, const std::vector<RenderChannel>& channels) const override {
@@ -305,7 +313,7 @@ Dataset Dataset::open(const fs::path& path, const DatasetOpenOptions& options) {
   impl.info = impl.source->info();
   if (impl.info.scenes.empty())
     impl.info.scenes.push_back({impl.info.name, 0, impl.info.frames, impl.info.near_plane, impl.info.far_plane,
-                                impl.info.vfov, 0});
+                                impl.info.vfov, 0, impl.info.hr_samples, impl.info.target});
   impl.options = options;
   resolve_channels(impl.info, options);
   for (auto c : impl.info.channels)
@@ -355,6 +363,8 @@ Dataset Dataset::scene(const std::string& name) const {
     auto view = std::make_shared<DatasetInfo>(info());
     if (view->scenes.size() > 1) view->name += "/" + name;
     view->scenes = {s};
+    view->hr_samples = s.hr_samples;  // a scene of a mixed set measures against its own target
+    view->target = s.target;
     for (Split split : {Split::Train, Split::Val, Split::Test}) {
       auto& list = const_cast<std::vector<int>&>(view->split.of(split));
       list.erase(std::remove_if(list.begin(), list.end(), [&](int f) { return !s.contains(f); }), list.end());

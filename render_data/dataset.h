@@ -26,6 +26,7 @@
 #include "render_data/dataset_manifest.h"
 #include "render_data/edges.h"
 #include "render_data/frame.h"
+#include "render_data/hr_samples.h"
 
 namespace cgsr {
 
@@ -61,6 +62,9 @@ struct SceneInfo {
   int first_frame = 0, frames = 0;
   double near_plane = 0.05, far_plane = 500, vfov = 60;  // the depth planes and FOV of its frames
   double weight = 0;  // sampling weight; 0 for every scene: proportional to its training frames
+  // Its ground truth (DatasetInfo::hr_samples, target): what a one-scene view of a set names.
+  int hr_samples = 0;
+  std::string target = kCapturedTarget;
   bool contains(int frame) const { return frame >= first_frame && frame < first_frame + frames; }
 };
 
@@ -84,6 +88,11 @@ struct DatasetInfo {
   // Every frame has a sub-pixel BSP border image at resolutions[0] (Frame::bsp_border; cgsr data
   // sets rendered with bsp_border).
   bool bsp_border = false;
+  // What the frames above the smallest resolution show, the ground truth the reports name: a cgsr
+  // render's hr_samples (hr_samples.h; 0 for anything else) and its description, e.g.
+  // "supersampled (4 samples per pixel, box filter)"; captures are taken as they come.
+  int hr_samples = 0;
+  std::string target = kCapturedTarget;
 };
 
 // What a layout implements: metadata, and one frame at one resolution with the given channels

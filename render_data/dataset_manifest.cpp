@@ -12,6 +12,7 @@
 #include "core/hash.h"
 #include "core/image_header.h"
 #include "core/text.h"
+#include "render_data/hr_samples.h"
 
 namespace cgsr {
 namespace fs = std::filesystem;
@@ -187,6 +188,10 @@ void write_manifest(const fs::path& root, const DatasetManifest& m) {
     out << YAML::Key << "encoding" << YAML::Value << "cgsr sub-pixel BSP border file version 1 (docs/bsp_border.md)";
     out << YAML::EndMap;
   }
+  if (m.hr_samples > 1) {
+    out << YAML::Key << "hr_samples" << YAML::Value << m.hr_samples;
+    out << YAML::Key << "hr_filter" << YAML::Value << m.hr_filter;
+  }
   if (!m.jitter_sequence.empty()) {
     out << YAML::Key << "jitter" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "resolution" << YAML::Value << m.resolutions.front().name();
@@ -349,6 +354,18 @@ DatasetManifest read_manifest(const fs::path& root) {
     config::detail::require_in_range(m.bsp_border_samples, 2, 16, bsp["samples"], bat.child("samples"));
   }
   if (const YAML::Node jitter = n["jitter"]) read_jitter(jitter, at.child("jitter"), m);
+  if (const YAML::Node samples = n["hr_samples"]) {
+    m.hr_samples = config::Codec<int>::decode(samples, at.child("hr_samples"));
+    if (hr_samples_per_side(m.hr_samples) == 0)
+      at.child("hr_samples").fail(samples, "is " + std::to_string(m.hr_samples) + ", must be " + hr_samples_expected());
+  }
+  if (m.hr_samples > 1) {
+    m.hr_filter = config::Codec<std::string>::decode(need("hr_filter"), at.child("hr_filter"));
+    if (m.hr_filter != kHrFilterBox)
+      at.child("hr_filter").fail(n["hr_filter"], "unknown filter '" + m.hr_filter + "' (known: " + kHrFilterBox + ")");
+  } else if (n["hr_filter"]) {
+    at.child("hr_filter").fail(n["hr_filter"], "a filter without hr_samples above 1 (one sample needs none)");
+  }
   return m;
 }
 

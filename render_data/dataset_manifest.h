@@ -85,6 +85,10 @@ struct DatasetManifest {
   std::string jitter_sequence;
   int jitter_phases = 0;
   std::vector<std::array<double, 2>> jitter_offsets;  // per frame
+  // Samples per pixel of the colour of every resolution but the smallest (render_data/hr_samples.h)
+  // and the filter that resolved them; 1 (no `hr_samples` key, as before the option): aliased.
+  int hr_samples = 1;
+  std::string hr_filter;  // "box" when hr_samples > 1
   // Multi-scene data sets only (then the frames live in the scenes' directories, and the planes,
   // field of view, seed and sizes are each scene's own).
   std::vector<ManifestScene> scenes;

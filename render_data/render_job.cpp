@@ -70,6 +70,7 @@ std::string render_fingerprint(const RenderJobOptions& o, uint64_t seed) {
   if (o.bsp_border.enabled())
     text += "|bsp_border " + std::to_string(o.bsp_border.depth) + " " + std::to_string(o.bsp_border.samples);
   if (o.jitter.enabled()) text += "|jitter " + o.jitter.sequence + " " + std::to_string(o.jitter.phases);
+  if (o.hr_samples != 1) text += "|hr_samples " + std::to_string(o.hr_samples) + " " + kHrFilterBox;
   return hex_fingerprint(text);
 }
 
@@ -90,6 +91,12 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   const auto resolutions = parse_resolutions(o.resolutions, "resolutions");
   if (o.bsp_border.enabled())  // before anything is written
     check_bsp_border_settings(o.bsp_border, resolutions.front().width, resolutions.front().height);
+  const int hr_side = hr_samples_per_side(o.hr_samples);
+  if (hr_side == 0)
+    throw Error("hr_samples", "is " + std::to_string(o.hr_samples) + ", must be " + hr_samples_expected());
+  if (o.hr_samples > 1 && resolutions.size() < 2)
+    throw Error("hr_samples", "supersamples the targets, every resolution but the smallest, and there is only " +
+                                  resolutions.front().name() + ": list a larger resolution or drop hr_samples");
   const SceneBundle bundle = make_scene(o.scene, seed);
 
   RenderJobResult result;
@@ -107,6 +114,10 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   if (o.bsp_border.enabled()) {
     m.bsp_border_depth = o.bsp_border.depth;
     m.bsp_border_samples = o.bsp_border.samples;
+  }
+  if (o.hr_samples > 1) {
+    m.hr_samples = o.hr_samples;
+    m.hr_filter = kHrFilterBox;
   }
   if (o.jitter.enabled()) {
     m.jitter_sequence = o.jitter.sequence;
@@ -129,6 +140,9 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
   result.triangles = renderer.geometry().triangle_count();
   spdlog::info("scene '{}': {} triangles, {} lights, {} textures; {} frames at {}", bundle.scene.name, result.triangles,
                bundle.scene.lights.size(), bundle.scene.textures.size(), o.frames, join(o.resolutions));
+  if (hr_side > 1)
+    spdlog::info("colour above {}: {}, rendered at {}x the resolution", resolutions.front().name(),
+                 hr_target_description(o.hr_samples, kHrFilterBox), hr_side);
 
   const auto& kinds = all_file_kinds();
   result.bytes_per_kind.assign(resolutions.size(), std::vector<double>(kinds.size(), 0.0));
@@ -151,7 +165,10 @@ RenderJobResult run_render_job(const RenderJobOptions& o, uint64_t seed, const f
         const Resolution& r = resolutions[ri];
         // Only the smallest resolution is jittered: the others are ground truth.
         const Vec2 jitter = ri == 0 ? jitter_offset(o.jitter, f) : Vec2{0, 0};
-        const GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane, jitter);
+        GBuffer g = renderer.render(pose, previous, r.width, r.height, m.near_plane, m.far_plane, jitter);
+        // The targets' colour supersampled; their G-buffers stay render()'s one sample per pixel.
+        if (ri > 0 && hr_side > 1)
+          g.color = renderer.render_color(pose, r.width, r.height, m.near_plane, m.far_plane, hr_side);
         write_frame_files(out, r, f, g);
         auto& rejected = result.motion_rejected[ri];
         rejected.pixels += g.motion_rejected;

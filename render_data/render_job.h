@@ -15,6 +15,10 @@
 //                                       # (bsp_border.h); depth 0 (the default): none
 //   jitter: {sequence: halton, phases: 8}  # sub-pixel jitter of the smallest resolution's frames
 //                                       # (jitter.h); sequence none (the default): none
+//   hr_samples: 4                       # samples per pixel of the colour of every resolution but
+//                                       # the smallest (the targets): n x n on a grid, n 1..4, box
+//                                       # filter in linear light (hr_samples.h); 1 (the default):
+//                                       # one, aliased. G-buffers keep one sample per pixel
 //   scene: {type: procedural, ...}      # scene_source.h
 
 #include <filesystem>
@@ -26,6 +30,7 @@
 #include "render_data/bsp_border_builder.h"
 #include "render_data/dataset_manifest.h"
 #include "render_data/edges.h"
+#include "render_data/hr_samples.h"
 #include "render_data/jitter.h"
 
 namespace cgsr {
@@ -39,6 +44,7 @@ struct RenderJobOptions {
   EdgeSettings edges;
   BspBorderSettings bsp_border;
   JitterSettings jitter;
+  int hr_samples = 1;  // samples per pixel of the targets' colour, n x n (hr_samples.h)
   config::Block scene;
 };
 
@@ -67,6 +73,11 @@ void add_render_job_fields(config::Schema<T>& s, bool scene_required = true) {
             "sub-pixel jitter of the smallest resolution's frames (sequence none: none)");
   // Off, the resolved config (and the render stage hash) is what it was before the key.
   s.omit_when("jitter", [](const T& o) { return !o.jitter.enabled(); });
+  s.field("hr_samples", static_cast<int T::*>(&RenderJobOptions::hr_samples),
+          "samples per pixel of the colour of every resolution but the smallest (n x n, box filter in linear light)")
+      .check([](int v) { return hr_samples_per_side(v) > 0; }, "must be " + hr_samples_expected());
+  // At 1, the resolved config (and the render stage hash) is what it was before the key.
+  s.omit_when("hr_samples", [](const T& o) { return o.hr_samples == 1; });
   s.block("scene", static_cast<config::Block T::*>(&RenderJobOptions::scene), "scene source {type: procedural, ...}");
   if (scene_required)
     s.validate([](const T& o, const config::Cursor& at, const YAML::Node& node) {

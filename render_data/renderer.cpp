@@ -12,6 +12,7 @@
 
 #include "core/config.h"
 #include "core/error.h"
+#include "render_data/hr_samples.h"
 
 namespace cgsr {
 namespace {
@@ -286,6 +287,51 @@ GBuffer SceneRenderer::render(const CameraPose& pose, const CameraPose& previous
 
   out.edge = detect_edges(out.depth, out.normal, out.object_id, settings_.edges);
   return std::move(out);
+}
+
+torch::Tensor SceneRenderer::render_color(const CameraPose& pose, int width, int height, float near_plane,
+                                          float far_plane, int samples) const {
+  if (width <= 0) throw Error("render", "image width " + config::out_of_range(width, 1, config::kUnbounded));
+  if (height <= 0) throw Error("render", "image height " + config::out_of_range(height, 1, config::kUnbounded));
+  if (samples < 1 || samples > kMaxHrSamplesPerSide)
+    throw Error("render", "samples per pixel side " + config::out_of_range(samples, 1, kMaxHrSamplesPerSide));
+  const int n = samples, W = width * n, H = height * n;
+  // The same projection at n x the size: its pixel coordinates are n x ours, so supersampled pixel
+  // (sy, sx) is the sample at ((sx + 0.5) / n, (sy + 0.5) / n) of pixel (sy / n, sx / n).
+  RenderContext ctx;
+  ctx.camera = make_frame_camera(pose, W, H, near_plane, far_plane);
+  ctx.previous = ctx.camera;
+  const SceneGeometry& g = geometry_;
+  transform_vertices(g, ctx);
+  rasterize_geometry(g, near_plane, W, H, settings_.tile_size, ctx);
+
+  torch::Tensor color = torch::empty({3, height, width}, torch::kFloat32);
+  float* out = color.data_ptr<float>();
+  const size_t plane = static_cast<size_t>(width) * height;
+  const float weight = 1.0f / static_cast<float>(n * n);
+  const int ts = std::max(1, settings_.tile_size / n);
+  tbb::parallel_for(tbb::blocked_range2d<int>(0, height, ts, 0, width, ts), [&](const tbb::blocked_range2d<int>& r) {
+    for (int i = r.rows().begin(); i < r.rows().end(); ++i)
+      for (int j = r.cols().begin(); j < r.cols().end(); ++j) {
+        Vec3 sum{};  // each pixel sums its samples in one order: independent of the threads
+        for (int sy = i * n; sy < (i + 1) * n; ++sy)
+          for (int sx = j * n; sx < (j + 1) * n; ++sx) {
+            const float cx = static_cast<float>(sx) + 0.5f, cy = static_cast<float>(sy) + 0.5f;
+            const int32_t si = ctx.visibility.screen_index[static_cast<size_t>(sy) * W + sx];
+            const ScreenTriangle* tri = si >= 0 ? &ctx.triangles[si] : nullptr;
+            const Material* mat = tri ? &g.material_of(tri->triangle) : nullptr;
+            const Vec3 linear = !tri || mat->sky ? sky_color(g.scene().sky, pixel_ray(ctx.camera, cx, cy))
+                                                 : shade_surface(ctx, g, *shader_, *tri, *mat, cx, cy).linear;
+            sum += Vec3{std::clamp(linear.x, 0.0f, 1.0f), std::clamp(linear.y, 0.0f, 1.0f),
+                        std::clamp(linear.z, 0.0f, 1.0f)};
+          }
+        const size_t p = static_cast<size_t>(i) * width + j;
+        out[p] = encode_srgb(sum.x * weight);
+        out[plane + p] = encode_srgb(sum.y * weight);
+        out[2 * plane + p] = encode_srgb(sum.z * weight);
+      }
+  });
+  return color;
 }
 
 namespace {

@@ -40,6 +40,14 @@ class SceneRenderer {
   GBuffer render(const CameraPose& pose, const CameraPose& previous, int width, int height, float near_plane,
                  float far_plane, Vec2 jitter = {0, 0}) const;
 
+  // Only the colour of the view from `pose` at width x height, with samples x samples samples per
+  // pixel (hr_samples.h): the view rasterized at samples x the size, each sample shaded as render()
+  // shades a pixel centre (with fog, or the sky) and clamped to [0, 1] (what it displays as), the
+  // pixel's samples averaged in linear light (a box filter), then sRGB-encoded: float32 [3,H,W] as
+  // GBuffer::color. Samples 1 is render()'s colour. Unjittered: it is ground truth.
+  torch::Tensor render_color(const CameraPose& pose, int width, int height, float near_plane, float far_plane,
+                             int samples) const;
+
   // The sub-pixel BSP border image (bsp_border.h) of the same view at width x height: the view is
   // rasterized again at settings.samples x the size, so every pixel gets samples^2 samples of which
   // triangle is visible (plus the ring of its neighbours' nearest samples); a pixel whose samples

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "eval/evaluation.h"
+#include "eval/report.h"
 #include "render_data/patch_sampler.h"
 #include "tests/support/tiny_data.h"
 
@@ -324,4 +325,47 @@ TEST(Evaluation, HistoryIsResetAtEverySceneCut) {
   const TimingSequence timing = timing_sequence(data, {cut}, 2, recording, 1);
   timing.run(recording, 0);
   EXPECT_EQ(recording.seen, (std::vector<int>{reset, cut}));
+}
+
+// Every evaluation names the ground truth it measured against: the tiny scene rendered aliased
+// and with 4 samples per pixel, a capture as captured; `cgsr eval` writes it into results.json
+// and prints it over its table, and the report keeps the two targets of one scene apart.
+TEST(Evaluation, ResultsNameTheTargetTheyMeasureAgainst) {
+  const auto dir = scratch_dir("eval-target");
+  const auto render = run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) +
+                               "/configs/scenes/tiny.yaml --set frames=3 --set hr_samples=4 --out '" +
+                               (dir / "aa").string() + "' --threads 1");
+  ASSERT_EQ(render.exit_code, 0) << render.all();
+  const std::string supersampled = "supersampled (4 samples per pixel, box filter)";
+  const auto r = run_cgsr("eval --data '" + (dir / "aa").string() + "' --model bicubic --split all --latency-runs 0 --out '" +
+                          (dir / "run").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = read_json(dir / "run" / "results.json");
+  EXPECT_EQ(j.at("target"), supersampled);
+  EXPECT_EQ(j.at("evaluations").at(0).at("target"), supersampled);
+  EXPECT_NE(r.out.find("Target: " + supersampled + "."), std::string::npos) << r.out;
+
+  auto bicubic = classic_upscalers().get("bicubic")(2);
+  const EvalResult aliased = evaluate(*bicubic, Dataset::open(tiny_data()), all_frames("0:3"));
+  EXPECT_EQ(aliased.target, "aliased (1 sample per pixel)");
+  const EvalResult smooth = evaluate(*bicubic, Dataset::open(dir / "aa"), all_frames("0:3"));
+  EXPECT_EQ(smooth.target, supersampled);
+  EXPECT_NE(smooth.psnr, aliased.psnr);  // the same LR input against another ground truth
+  EXPECT_EQ(eval_result_from_json(to_json(smooth), "test").target, supersampled);
+  auto old = to_json(smooth);
+  old.erase("target");  // results written before the field load with none
+  EXPECT_EQ(eval_result_from_json(old, "old.json").target, "");
+  const auto tables = group_results({aliased, smooth});
+  ASSERT_EQ(tables.size(), 2u);
+  EXPECT_EQ(tables[1].target, supersampled);
+  EXPECT_NE(report_markdown(tables[0]).find("Target: aliased (1 sample per pixel)."), std::string::npos);
+  // Quoted: the description holds a comma.
+  EXPECT_NE(report_csv(tables).find(",\"" + supersampled + "\"\n"), std::string::npos) << report_csv(tables);
+
+  const std::string root = tiny_data().string();
+  std::ofstream(dir / "capture.yaml") << "layout: glob\nresolutions:\n"
+                                         "  - {size: 64x48, color: '" << root << "/64x48/color/*.png'}\n"
+                                         "  - {size: 128x96, color: '" << root << "/128x96/color/*.png'}\n";
+  EXPECT_EQ(evaluate(*bicubic, Dataset::open(dir / "capture.yaml"), all_frames("0:3")).target, "as captured");
+  std::filesystem::remove_all(dir);
 }

@@ -35,7 +35,7 @@ EvalResult row(const std::string& name, double psnr, std::optional<double> ms, s
 
 TEST(Report, ParetoFrontKeepsOnlyUndominatedRows) {
   ReportTable t{"hall", 2, {row("fast", 30, 1.0), row("slow-worse", 29, 5.0), row("slow-better", 33, 10.0),
-                            row("no-latency", 40, std::nullopt)}};
+                            row("no-latency", 40, std::nullopt)}, ""};
   EXPECT_EQ(pareto_front(t), (std::vector<size_t>{0, 2}));
 }
 
@@ -49,7 +49,7 @@ TEST(Report, GroupsByDatasetAndScale) {
 }
 
 TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
-  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}};
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}, ""};
   const auto md = report_markdown(t);
   EXPECT_NE(md.find("| bicubic * | NA | NA | 0.50 | 30.12 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| pan * | 261.4 | 0.26 | 12.00 | 33.46 |"), std::string::npos) << md;
@@ -58,7 +58,7 @@ TEST(Report, MarkdownAndCsvCarryTheComputedValues) {
 }
 
 TEST(Report, CsvQuotesNamesWithCommasAndQuotes) {
-  ReportTable t{"hall, east", 2, {row("PAN x2 (keep 0.5, \"wide\")", 33.456, 12.0)}};
+  ReportTable t{"hall, east", 2, {row("PAN x2 (keep 0.5, \"wide\")", 33.456, 12.0)}, ""};
   const auto csv = report_csv({t});
   EXPECT_NE(csv.find("\n\"hall, east\",2,\"PAN x2 (keep 0.5, \"\"wide\"\")\",,,12.0000,33.4560"), std::string::npos)
       << csv;
@@ -66,7 +66,7 @@ TEST(Report, CsvQuotesNamesWithCommasAndQuotes) {
 
 TEST(Report, ALatencyColumnOnlyWhenSomeRowWasTimed) {
   // A held-out scene is evaluated for quality only: no latency column, no Pareto front.
-  ReportTable t{"hall", 2, {row("bicubic", 30.123, std::nullopt), row("pan", 33.456, std::nullopt, 261403)}};
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, std::nullopt), row("pan", 33.456, std::nullopt, 261403)}, ""};
   const auto md = report_markdown(t);
   EXPECT_NE(md.find("| Model | Params (k) | MACs (G) | PSNR (dB) | SSIM |"), std::string::npos) << md;
   EXPECT_NE(md.find("| pan | 261.4 | 0.26 | 33.46 | 0.9000 |"), std::string::npos) << md;
@@ -75,14 +75,14 @@ TEST(Report, ALatencyColumnOnlyWhenSomeRowWasTimed) {
 }
 
 TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
-  ReportTable plain{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}};
+  ReportTable plain{"hall", 2, {row("bicubic", 30.123, 0.5), row("pan", 33.456, 12.0, 261403)}, ""};
   EXPECT_EQ(report_markdown(plain).find("Edge PSNR"), std::string::npos);
 
   auto pan = row("pan", 33.456, 12.0, 261403);
   pan.psnr_edge = 27.891;
   pan.psnr_rest = 34.012;
   pan.edge_fraction = 0.0731;
-  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), pan}};  // bicubic: an older result without them
+  ReportTable t{"hall", 2, {row("bicubic", 30.123, 0.5), pan}, ""};  // bicubic: an older result without them
   const auto md = report_markdown(t);
   EXPECT_NE(md.find("| PSNR (dB) | Edge PSNR (dB) | Rest PSNR (dB) | SSIM |"), std::string::npos) << md;
   EXPECT_NE(md.find("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n"), std::string::npos) << md;
@@ -91,17 +91,17 @@ TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
   EXPECT_NE(md.find("(7.3% of the pixels)"), std::string::npos) << md;
 
   const auto csv = report_csv({t});
-  EXPECT_NE(csv.find("onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find(",27.8910,34.0120,0.073100\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("onnxruntime_latency_ms,psnr_edge,psnr_rest,edge_fraction,target\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",27.8910,34.0120,0.073100,\n"), std::string::npos) << csv;  // no target: an older result
   EXPECT_NE(csv.find("hall,2,bicubic,"), std::string::npos) << csv;
-  EXPECT_NE(csv.find(",,,\n"), std::string::npos) << csv;  // bicubic: no ONNX Runtime, no edge figures
+  EXPECT_NE(csv.find(",,,,\n"), std::string::npos) << csv;  // bicubic: no ONNX Runtime, no edge figures
 }
 
 TEST(Report, PlotIsAPngAndAnSvg) {
   const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-plot";
   auto pan = row("pan", 33, 12.0, 261403);
   pan.psnr_edge = 28;
-  ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), pan, row("fsr", 31, std::nullopt)}};
+  ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), pan, row("fsr", 31, std::nullopt)}, ""};
   write_scatter_plot(dir / "plot.png", report_plot(t));
   write_scatter_plot(dir / "plot.svg", report_plot(t));
   const auto png = read_file(dir / "plot.png"), svg = read_file(dir / "plot.svg");
@@ -116,7 +116,7 @@ TEST(Report, PlotIsAPngAndAnSvg) {
 TEST(Report, PlotMarksRolesAndJoinsPairs) {
   ReportTable t{"hall", 2,
                 {row("bicubic", 30, 0.5), row("pan", 33, 12.0, 261403), row("pan (control)", 33.1, 12.1, 261403),
-                 row("pan cg", 33.3, 12.5, 270000), row("slim", 33.2, 4.0, 70000)}};
+                 row("pan cg", 33.3, 12.5, 270000), row("slim", 33.2, 4.0, 70000)}, ""};
   ReportRoles roles;
   roles.finals = {"slim"};
   roles.controls = {"pan (control)"};
