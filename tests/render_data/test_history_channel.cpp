@@ -8,6 +8,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -272,6 +273,46 @@ TEST(HistoryChannel, ANetworkReadingItTrains) {
   ASSERT_EQ(train.exit_code, 0) << train.all();
   EXPECT_TRUE(fs::exists(dir / "train" / "model.cgsr"));
   fs::remove_all(dir);
+}
+
+// The measurement of docs/results/history.md, on a data set named by CGSR_HISTORY_DATA (disabled:
+// run with --gtest_also_run_disabled_tests): per age, the PSNR of the history's samples against
+// the HR ground truth and of bicubic on the same pixels; the fraction of HR pixels covered.
+TEST(HistoryChannel, DISABLED_MeasureByAge) {
+  const char* path = std::getenv("CGSR_HISTORY_DATA");
+  if (!path) GTEST_SKIP() << "set CGSR_HISTORY_DATA to a jittered data set";
+  const Dataset all = Dataset::open(path, with_channels({"history"}));
+  const size_t hr = all.resolutions().size() - 1;
+  const int s = lr_multiple(all.info(), hr);
+  namespace F = torch::nn::functional;
+  std::vector<double> se(kHistoryFrames + 1, 0), bicubic_se(kHistoryFrames + 1, 0);
+  std::vector<int64_t> count(kHistoryFrames + 1, 0);
+  int64_t pixels = 0;
+  for (int t : all.frames(Split::All)) {
+    const torch::Tensor history = all.frame(t, hr)->history;
+    const torch::Tensor truth = all.load(t, hr).color_float();
+    const torch::Tensor bicubic =
+        F::interpolate(all.load(t, 0).color_float().unsqueeze(0),
+                       F::InterpolateFuncOptions().scale_factor(std::vector<double>{double(s), double(s)}).mode(torch::kBicubic).align_corners(false))[0]
+            .clamp(0, 1);
+    pixels += history[3].numel();
+    for (int k = 0; k <= kHistoryFrames; ++k) {
+      const torch::Tensor mask = (history[3] - (1.0f - static_cast<float>(k) / (kHistoryFrames + 1))).abs() < 1e-6;
+      const torch::Tensor truth_here = at(truth, mask);
+      se[k] += (at(history.slice(0, 0, 3), mask) - truth_here).pow(2).sum().item<double>();
+      bicubic_se[k] += (at(bicubic, mask) - truth_here).pow(2).sum().item<double>();
+      count[k] += mask.sum().item<int64_t>();
+    }
+  }
+  int64_t covered = 0;
+  std::cout << "age | pixels | share of HR pixels | history PSNR | bicubic PSNR (same pixels)\n";
+  for (int k = 0; k <= kHistoryFrames; ++k) {
+    covered += count[k];
+    const auto db = [&](double e) { return count[k] ? 10 * std::log10(3.0 * count[k] / e) : 0.0; };
+    std::cout << k << " | " << count[k] << " | " << static_cast<double>(count[k]) / pixels << " | " << db(se[k]) << " | "
+              << db(bicubic_se[k]) << "\n";
+  }
+  std::cout << "covered " << static_cast<double>(covered) / pixels << " of " << pixels << " HR pixels\n";
 }
 
 }  // namespace history_channel_test
