@@ -17,6 +17,12 @@ bool same_surface_depth(float a, float b, double tolerance) {
   return std::abs(a - b) <= tolerance * std::min(a, b);
 }
 
+bool history_link_holds(float older, float newer, const HistoryDepthTest& test) {
+  const bool sky_older = std::isinf(older), sky_newer = std::isinf(newer);
+  if (sky_older || sky_newer) return sky_older && sky_newer;
+  return older >= newer * (1 - test.link_nearer) && older <= newer * (1 + test.link_farther);
+}
+
 namespace {
 
 // A frame's tensors as contiguous float32, checked against the sizes they must have.
@@ -37,7 +43,7 @@ torch::Tensor checked(const torch::Tensor& t, int64_t channels, int64_t h, int64
 }  // namespace
 
 torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale, const std::string& what,
-                              double depth_tolerance) {
+                              const HistoryDepthTest& depth_test) {
   if (frames.empty()) throw Error(what, "the history channel needs the current frame");
   if (frames.size() > static_cast<size_t>(kHistoryFrames) + 1)
     throw Error(what, "the history channel gathers at most " + std::to_string(kHistoryFrames + 1) + " frames, got " +
@@ -79,7 +85,7 @@ torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale
           if (!(qx >= 0 && qx < W && qy >= 0 && qy < H)) break;  // left the image (or NaN motion)
           if (p[k].d) {
             const float here = p[k].d[static_cast<int64_t>(std::floor(qy)) * W + static_cast<int64_t>(std::floor(qx))];
-            if (!same_surface_depth(here, ref, depth_tolerance)) break;  // hidden in this frame
+            if (!history_link_holds(here, ref, depth_test)) break;  // hidden in this frame, or lost
             ref = here;
           }
         }
@@ -90,7 +96,7 @@ torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale
         if (x < 0 || x >= w || y < 0 || y >= h) continue;
         if (std::abs(scale * (x + 0.5 - jx) - qx) > 0.5 || std::abs(scale * (y + 0.5 - jy) - qy) > 0.5) continue;
         const int64_t s = y * w + x;
-        if (!same_surface_depth(p[k].ld[s], ref, depth_tolerance)) continue;
+        if (!same_surface_depth(p[k].ld[s], ref, depth_test.sample)) continue;
         const int64_t to = i * W + j;
         for (int c = 0; c < 3; ++c) o[c * plane + to] = p[k].c[c * lr_plane + s];
         o[3 * plane + to] = 1.0f - static_cast<float>(k) / (kHistoryFrames + 1);

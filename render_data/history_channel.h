@@ -27,12 +27,17 @@ namespace cgsr {
 
 // Previous frames gathered (K): the current frame's samples and K older ones.
 constexpr int kHistoryFrames = 4;
-// Relative depth difference above which a sample, or a chain link, is taken for another surface.
-// A link compares view depths of two frames, which a walking camera changes by its step: on the
-// tiny scene (tests, ~10 px of motion a frame at 128x96) 0.05 keeps half the warped samples 0.1
-// does, at +2.5 dB over bicubic against +2.4; 0.2 doubles them again but falls to +1.5 dB, and
-// no test at all (+-0 dB) takes occluders' colours (docs/results/history.md).
+// The depth tests (relative differences of linear view depth). A sample is compared with the
+// chain's depth in its own frame's view; a link compares two frames' views of one point, nearer in
+// the older frame where the point was hidden there (disocclusion), farther where the chain jumped
+// to a surface behind. The bounds are separate so that they can be measured apart
+// (docs/results/history.md): looser ones, either way, add samples barely better than bicubic.
 constexpr double kHistoryDepthTolerance = 0.1;
+struct HistoryDepthTest {
+  double sample = kHistoryDepthTolerance;       // |LR depth - chain depth| above this: another surface
+  double link_nearer = kHistoryDepthTolerance;  // older frame nearer by more: occluded there, the chain ends
+  double link_farther = kHistoryDepthTolerance; // older frame farther by more: another surface, the chain ends
+};
 
 // One frame of the chain, all as the data set stores them.
 struct HistoryFrame {
@@ -45,6 +50,8 @@ struct HistoryFrame {
 
 // Whether two linear depths are one surface: both the sky, or within `tolerance` of the nearer.
 bool same_surface_depth(float a, float b, double tolerance);
+// Whether a chain link holds: `older`, the point's depth in the older frame, against `newer`.
+bool history_link_holds(float older, float newer, const HistoryDepthTest& test);
 
 // `frames[0]` is frame t, `frames[k]` frame t-k (at most kHistoryFrames + 1; fewer at a scene's
 // start). Returns float32 [4, scale*h, scale*w]: (r, g, b) of the sample in [0,1], then recency
@@ -52,6 +59,6 @@ bool same_surface_depth(float a, float b, double tolerance);
 // Throws cgsr::Error naming `what` (e.g. the data set and frame) when a tensor is missing or of
 // the wrong size.
 torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale, const std::string& what,
-                              double depth_tolerance = kHistoryDepthTolerance);
+                              const HistoryDepthTest& depth_test = {});
 
 }  // namespace cgsr

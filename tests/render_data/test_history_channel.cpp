@@ -8,6 +8,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -161,7 +162,8 @@ TEST(HistoryChannel, WarpingReproducesTheFrameAndRejectsDisocclusions) {
     covered += (recency > 0).sum().item<int64_t>();
     pixels += recency.numel();
     // Without the depth test: what it rejected.
-    const torch::Tensor loose = history_channel(chain, s, "loose", std::numeric_limits<double>::max());
+    const double none = std::numeric_limits<double>::max();
+    const torch::Tensor loose = history_channel(chain, s, "loose", {none, none, none});
     const torch::Tensor extra = (loose[3] > 0) & (recency == 0);
     extra_history.push_back(at(loose.slice(0, 0, 3), extra));
     extra_truth.push_back(at(truth, extra));
@@ -313,6 +315,39 @@ TEST(HistoryChannel, DISABLED_MeasureByAge) {
               << db(bicubic_se[k]) << "\n";
   }
   std::cout << "covered " << static_cast<double>(covered) / pixels << " of " << pixels << " HR pixels\n";
+  // CGSR_HISTORY_SWEEP="sample,nearer,farther;...": the warped samples (age >= 1) under other depth tests.
+  const char* sweep = std::getenv("CGSR_HISTORY_SWEEP");
+  if (!sweep) return;
+  std::stringstream variants(sweep);
+  std::string variant;
+  const Dataset stored = Dataset::open(path);  // depth and motion, for the chains
+  std::cout << "sample | link nearer | link farther | warped pixels | history PSNR | bicubic PSNR (same pixels)\n";
+  while (std::getline(variants, variant, ';')) {
+    HistoryDepthTest test;
+    ASSERT_EQ(std::sscanf(variant.c_str(), "%lf,%lf,%lf", &test.sample, &test.link_nearer, &test.link_farther), 3) << variant;
+    double warped_se = 0, warped_bicubic_se = 0;
+    int64_t warped = 0;
+    for (int t : all.frames(Split::All)) {
+      std::vector<HistoryFrame> chain;
+      for (int k = 0, f = t; k <= kHistoryFrames; ++k, --f) {
+        if (k > 0 && !all.has_previous(f + 1)) break;
+        const Frame lr = stored.load(f, 0), h = k < kHistoryFrames ? stored.load(f, hr) : Frame();
+        chain.push_back({lr.color, lr.depth, lr.jitter, h.depth, h.motion});
+      }
+      const torch::Tensor history = history_channel(chain, s, "sweep", test);
+      const torch::Tensor mask = (history[3] > 0) & (history[3] < 1);
+      const torch::Tensor truth = at(all.load(t, hr).color_float(), mask);
+      const torch::Tensor bicubic =
+          F::interpolate(all.load(t, 0).color_float().unsqueeze(0),
+                         F::InterpolateFuncOptions().scale_factor(std::vector<double>{double(s), double(s)}).mode(torch::kBicubic).align_corners(false))[0]
+              .clamp(0, 1);
+      warped_se += (at(history.slice(0, 0, 3), mask) - truth).pow(2).sum().item<double>();
+      warped_bicubic_se += (at(bicubic, mask) - truth).pow(2).sum().item<double>();
+      warped += mask.sum().item<int64_t>();
+    }
+    std::cout << test.sample << " | " << test.link_nearer << " | " << test.link_farther << " | " << warped << " | "
+              << 10 * std::log10(3.0 * warped / warped_se) << " | " << 10 * std::log10(3.0 * warped / warped_bicubic_se) << "\n";
+  }
 }
 
 }  // namespace history_channel_test
