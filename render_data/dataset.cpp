@@ -468,6 +468,18 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
   return Dataset::open(path, open);
 }
 
+Dataset open_with_asked_channels(const fs::path& path, const std::vector<RenderChannel>& channels) {
+  const Dataset all = Dataset::open(path);
+  auto wanted = all.info().channels;
+  const bool asked = std::find(channels.begin(), channels.end(), RenderChannel::History) != channels.end();
+  if (!asked || std::find(wanted.begin(), wanted.end(), RenderChannel::History) != wanted.end()) return all;
+  wanted.push_back(RenderChannel::History);
+  std::sort(wanted.begin(), wanted.end());
+  DatasetOpenOptions open;
+  open.channels = channel_names(wanted);
+  return Dataset::open(path, open);
+}
+
 std::vector<int> spread_frames(const std::vector<int>& frames, int count) {
   if (count <= 0 || static_cast<size_t>(count) >= frames.size()) return frames;
   std::vector<int> out;

@@ -145,6 +145,11 @@ std::vector<int> spread_frames(const std::vector<int>& frames, int count);
 // them overflows and decodes frames over and over.
 Dataset open_for_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
 
+// The data set at `path` with every channel it gives by default, plus those of `channels` that are
+// derived only when asked for (history): for readers that pick their channels later (`cgsr ablate`'s
+// channel sets). Data that cannot give them is the error opening them names.
+Dataset open_with_asked_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
+
 // Loader entry points (dataset.cpp registers them).
 std::unique_ptr<FrameSource> open_cgsr_dataset(const std::filesystem::path& root, const DatasetOpenOptions& options);
 std::unique_ptr<FrameSource> open_cgsr_release(const std::filesystem::path& root, const DatasetOpenOptions& options);

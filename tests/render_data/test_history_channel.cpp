@@ -291,6 +291,31 @@ TEST(HistoryChannel, ANetworkReadingItTrains) {
   fs::remove_all(dir);
 }
 
+// `cgsr ablate` with history in a channel set: the data set is opened with the channel though it
+// is not derived by default, and the variant trains and evaluates.
+TEST(HistoryChannel, AnAblationChannelSetReadsIt) {
+  const auto dir = test::scratch_dir("history-ablate");
+  const auto plain = test::run_cgsr("train --data " + jittered_data().string() +
+                                    " --model pan --steps 1 --threads 1 --set schedule.batch_size=2"
+                                    " --set schedule.patch_size=16 --set schedule.val_frames=1 --out " +
+                                    (dir / "plain").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.all();
+  const auto r = test::run_cgsr(
+      "ablate --data " + jittered_data().string() + " --model " + (dir / "plain" / "model.cgsr").string() +
+      " --threads 1 --set ablation.sources=[hr_fuse] --set ablation.seeds=[1] --set ablation.leave_out=false"
+      " --set ablation.rit.channels=[depth,edge] --set ablation.small_width=0 --set ablation.schedule.steps=2"
+      " --set ablation.schedule.batch_size=2 --set ablation.schedule.patch_size=16"
+      " --set ablation.schedule.validate_every=0 --set ablation.schedule.val_frames=1"
+      " --set ablation.schedule.layout=nchw --set ablation.eval.latency_runs=0 --set ablation.eval.split=all"
+      " --set 'ablation.channel_sets=[[depth, history]]' --out " + (dir / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.all();
+  const auto rows = test::read_json(dir / "run" / "results.json").at("rows");
+  bool found = false;
+  for (const auto& row : rows) found = found || row.at("variant") == "hr_fuse [depth+history]";
+  EXPECT_TRUE(found) << rows;
+  fs::remove_all(dir);
+}
+
 // The measurement of docs/results/history.md, on a data set named by CGSR_HISTORY_DATA (disabled:
 // run with --gtest_also_run_disabled_tests): per age, the PSNR of the history's samples against
 // the HR ground truth and of bicubic on the same pixels; the fraction of HR pixels covered.
