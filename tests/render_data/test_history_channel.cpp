@@ -13,6 +13,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -240,13 +241,21 @@ TEST(HistoryChannel, ResetsAtASceneCut) {
   fs::remove_all(dir);
 }
 
-// Two loads give the same tensor; a capture without motion asked for `history` names the data
+// Two loads give the same tensor, also loaded from several threads; a capture without motion asked for `history` names the data
 // set, each resolution and what it lacks; the channel is not derived unless asked for.
 TEST(HistoryChannel, IsDeterministicAndAClearErrorWithoutMotion) {
   const Dataset a = Dataset::open(jittered_data(), with_channels({"history"}));
   const Dataset b = Dataset::open(jittered_data(), with_channels({"depth", "history"}));
   EXPECT_TRUE(torch::equal(a.load(5, 1).history, b.load(5, 1).history));
   EXPECT_TRUE(torch::equal(a.load(3, 0).history, a.load(3, 0).history));
+  // Frames derived from several threads at once (the patch sampler's prefetch) are the same: a
+  // frame's history reads its predecessors' stored channels, never the cache it is being added to.
+  const Dataset shared = Dataset::open(jittered_data(), with_channels({"history"}));
+  std::vector<torch::Tensor> parallel(8);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 8; ++i) threads.emplace_back([&, i] { parallel[i] = shared.frame(4 + i % 4, 1)->history; });
+  for (auto& t : threads) t.join();
+  for (int i = 0; i < 8; ++i) EXPECT_TRUE(torch::equal(parallel[i], a.load(4 + i % 4, 1).history)) << i;
   const auto defaults = Dataset::open(jittered_data()).info().channels;
   EXPECT_EQ(std::find(defaults.begin(), defaults.end(), RenderChannel::History), defaults.end());
   EXPECT_TRUE(open_for_channels(jittered_data(), {RenderChannel::History}).frame(2, 1)->has(RenderChannel::History));
