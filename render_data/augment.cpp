@@ -32,15 +32,15 @@ torch::Tensor augment_info_color(const torch::Tensor& info, const std::vector<Re
                                  const ColorAugmentation& a) {
   const int64_t cdim = info.dim() - 3;
   int64_t offset = 0;
+  torch::Tensor out = info;
   for (auto c : channels) {
-    if (c == RenderChannel::Bsp) {
-      torch::Tensor out = info.clone();
+    if (c == RenderChannel::Bsp || c == RenderChannel::History) {
+      if (out.is_same(info)) out = info.clone();
       out.narrow(cdim, offset, 3).copy_(augment_color(info.narrow(cdim, offset, 3), a));
-      return out;
     }
     offset += channel_width(c);
   }
-  return info;
+  return out;
 }
 
 torch::Tensor augment_image(const torch::Tensor& image, const Augmentation& a) {

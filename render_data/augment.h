@@ -41,8 +41,9 @@ torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderCh
 
 // `color`: [3,H,W] or [N,3,H,W] in [0, 1].
 torch::Tensor augment_color(const torch::Tensor& color, const ColorAugmentation& a);
-// The colour augmentation of the rendering information: the bsp channel's colour (an image of the
-// scene's colours) gets the one its frame's colour gets; other channels are not colours.
+// The colour augmentation of the rendering information: the colour of the bsp and history channels
+// (images of the scene's colours) gets the one its frame's colour gets; other channels are not
+// colours (history's recency stays).
 torch::Tensor augment_info_color(const torch::Tensor& info, const std::vector<RenderChannel>& channels,
                                  const ColorAugmentation& a);
 

@@ -16,6 +16,7 @@
 #include "render_data/bsp_channel.h"
 #include "render_data/derive_channels.h"
 #include "render_data/frame_files.h"
+#include "render_data/history_channel.h"
 #include "render_data/render_job.h"
 
 namespace cgsr {
@@ -79,10 +80,39 @@ double default_frame_cache_reserve_gb() {
   return gb > 0 ? gb / 8 : 1.0;
 }
 
-bool bsp_available_at(const DatasetInfo& info, size_t resolution) {
-  if (!info.bsp_border || info.resolutions.empty()) return false;
+int lr_multiple(const DatasetInfo& info, size_t resolution) {
+  if (info.resolutions.empty()) return 0;
   const Resolution& lo = info.resolutions.front(), &r = info.resolutions.at(resolution);
-  return r.width % lo.width == 0 && r.height % lo.height == 0 && r.width / lo.width == r.height / lo.height;
+  const bool whole = r.width % lo.width == 0 && r.height % lo.height == 0 && r.width / lo.width == r.height / lo.height;
+  return whole ? r.width / lo.width : 0;
+}
+
+bool bsp_available_at(const DatasetInfo& info, size_t resolution) {
+  return info.bsp_border && lr_multiple(info, resolution) > 0;
+}
+
+std::string history_missing_at(const DatasetInfo& info, size_t resolution) {
+  const Resolution& r = info.resolutions.at(resolution);
+  if (lr_multiple(info, resolution) == 0)
+    return r.name() + " is not an integer multiple of the jittered resolution " + info.resolutions.front().name();
+  const auto& at = info.stored_at.empty() ? info.stored : info.stored_at[resolution];
+  const auto& lr = info.stored_at.empty() ? info.stored : info.stored_at.front();
+  auto has = [](const std::vector<RenderChannel>& v, RenderChannel c) { return std::find(v.begin(), v.end(), c) != v.end(); };
+  std::vector<std::string> missing;
+  if (!has(at, RenderChannel::Motion)) missing.push_back("motion at " + r.name());
+  if (!has(at, RenderChannel::Depth)) missing.push_back("depth at " + r.name());
+  if (resolution != 0 && !has(lr, RenderChannel::Depth)) missing.push_back("depth at " + info.resolutions.front().name());
+  return missing.empty() ? std::string() : "the data set has no " + join(missing, " and no ");
+}
+
+bool history_available_at(const DatasetInfo& info, size_t resolution) {
+  return !info.resolutions.empty() && history_missing_at(info, resolution).empty();
+}
+
+bool has_previous_frame(const DatasetInfo& info, int frame) {
+  for (const auto& s : info.scenes)
+    if (s.contains(frame)) return frame > s.first_frame;
+  throw Error(info.root.string(), "frame " + config::out_of_range(frame, 0, info.frames - 1));
 }
 
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
@@ -111,6 +141,21 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
       info.derived.push_back(c);
       continue;
     }
+    if (c == RenderChannel::History) {
+      // Made from motion and depth (history_channel.h): an error when no resolution can have it.
+      std::vector<std::string> why;
+      bool anywhere = false;
+      for (size_t r = 0; r < info.resolutions.size(); ++r) {
+        const std::string missing = history_missing_at(info, r);
+        anywhere = anywhere || missing.empty();
+        if (!missing.empty()) why.push_back(info.resolutions[r].name() + ": " + missing);
+      }
+      if (!anywhere)
+        throw Error(info.root.string(), "cannot derive the 'history' channel at any resolution (" + join(why, "; ") +
+                                            "): it is made from the motion and depth of the previous frames");
+      info.derived.push_back(c);
+      continue;
+    }
     const bool asked = std::find(derive.begin(), derive.end(), c) != derive.end();
     if (!asked || !derivable(c))
       throw Error(info.root.string(), "the dataset has no '" + channel_name(c) + "' channel (stored: " +
@@ -129,8 +174,10 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
     std::vector<RenderChannel> out;
     for (auto c : requested) {
       const bool derived = std::find(info.derived.begin(), info.derived.end(), c) != info.derived.end();
-      if (c == RenderChannel::Bsp ? bsp_available_at(info, r) : has(c) || (derived && has(RenderChannel::Depth)))
-        out.push_back(c);
+      const bool available = c == RenderChannel::Bsp       ? bsp_available_at(info, r)
+                             : c == RenderChannel::History ? history_available_at(info, r)
+                                                           : has(c) || (derived && has(RenderChannel::Depth));
+      if (available) out.push_back(c);
     }
     info.channels_at.push_back(out);
   }
@@ -139,7 +186,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
 std::vector<RenderChannel> depth_derived(const DatasetInfo& info) {
   std::vector<RenderChannel> out;
   for (auto c : info.derived)
-    if (c != RenderChannel::Bsp) out.push_back(c);
+    if (c != RenderChannel::Bsp && c != RenderChannel::History) out.push_back(c);
   return out;
 }
 
@@ -276,7 +323,38 @@ struct Dataset::Impl {
     if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Bsp) != info.channels.end() &&
         bsp_available_at(info, res))
       f.bsp = resolve_bsp(index, res, f);
+    if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::History) != info.channels.end() &&
+        history_available_at(info, res))
+      f.history = resolve_history(index, res, f);
     return f;
+  }
+
+  // The history channel of frame `index` at resolution `res`: the frame and up to kHistoryFrames
+  // predecessors of its scene, their stored channels read from the source (never through the cache:
+  // a cached frame would derive its own history, K frames deeper each time).
+  torch::Tensor resolve_history(int index, size_t res, const Frame& f) const {
+    const int scale = lr_multiple(info, res);
+    std::vector<HistoryFrame> chain;
+    for (int k = 0, frame = index; k <= kHistoryFrames; ++k, --frame) {
+      if (k > 0 && !has_previous_frame(info, frame + 1)) break;  // a scene cut: the history starts here
+      HistoryFrame h;
+      // Motion and depth at r link the chain; the oldest frame only gives its LR samples.
+      const bool link = k < kHistoryFrames;
+      Frame at_r;
+      if (k == 0 && f.depth.defined() && f.motion.defined())
+        at_r = f;
+      else if (link)
+        at_r = source->load(frame, res, {RenderChannel::Depth, RenderChannel::Motion});
+      h.depth = at_r.depth;
+      h.motion = at_r.motion;
+      const Frame lr = res == 0 && at_r.color.defined() ? at_r : source->load(frame, 0, {RenderChannel::Depth});
+      h.lr_color = lr.color;
+      h.lr_depth = lr.depth;
+      h.jitter = lr.jitter;
+      chain.push_back(std::move(h));
+    }
+    return history_channel(chain, scale, info.root.string() + ": frame " + std::to_string(index) + " at " +
+                                             info.resolutions[res].name());
   }
 
   // The bsp channel of frame `index` at resolution `res`: the LR frame's BSP border image resolved
@@ -351,7 +429,7 @@ std::vector<int> Dataset::frames(Split split) const {
 
 const std::vector<SceneInfo>& Dataset::scenes() const { return info().scenes; }
 const SceneInfo& Dataset::scene_of(int frame) const { return find_scene(impl_->info, frame); }
-bool Dataset::has_previous(int frame) const { return frame > scene_of(frame).first_frame; }
+bool Dataset::has_previous(int frame) const { return has_previous_frame(impl_->info, frame); }
 
 Dataset Dataset::scene(const std::string& name) const {
   std::vector<std::string> names;
@@ -386,15 +464,29 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
       needed.push_back(c);
   };
   for (auto c : channels) need(c);
-  // Kept when the data cannot give it, so that opening says what is missing and how to render it.
-  if (std::find(channels.begin(), channels.end(), RenderChannel::Bsp) != channels.end() &&
-      std::find(needed.begin(), needed.end(), RenderChannel::Bsp) == needed.end())
-    needed.push_back(RenderChannel::Bsp);
+  // Derived only when asked for (history), or kept when the data cannot give it, so that opening
+  // says what is missing and how to render it.
+  for (auto c : {RenderChannel::Bsp, RenderChannel::History})
+    if (std::find(channels.begin(), channels.end(), c) != channels.end() &&
+        std::find(needed.begin(), needed.end(), c) == needed.end())
+      needed.push_back(c);
   need(RenderChannel::Edge);
   std::sort(needed.begin(), needed.end());
   DatasetOpenOptions open;
   open.channels = channel_names(needed);
   if (open.channels.empty()) return all;  // no edge map either: every channel it has
+  return Dataset::open(path, open);
+}
+
+Dataset open_with_asked_channels(const fs::path& path, const std::vector<RenderChannel>& channels) {
+  const Dataset all = Dataset::open(path);
+  auto wanted = all.info().channels;
+  const bool asked = std::find(channels.begin(), channels.end(), RenderChannel::History) != channels.end();
+  if (!asked || std::find(wanted.begin(), wanted.end(), RenderChannel::History) != wanted.end()) return all;
+  wanted.push_back(RenderChannel::History);
+  std::sort(wanted.begin(), wanted.end());
+  DatasetOpenOptions open;
+  open.channels = channel_names(wanted);
   return Dataset::open(path, open);
 }
 

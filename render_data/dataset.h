@@ -154,6 +154,11 @@ std::vector<int> spread_frames(const std::vector<int>& frames, int count);
 // them overflows and decodes frames over and over.
 Dataset open_for_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
 
+// The data set at `path` with every channel it gives by default, plus those of `channels` that are
+// derived only when asked for (history): for readers that pick their channels later (`cgsr ablate`'s
+// channel sets). Data that cannot give them is the error opening them names.
+Dataset open_with_asked_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
+
 // Loader entry points (dataset.cpp registers them).
 std::unique_ptr<FrameSource> open_cgsr_dataset(const std::filesystem::path& root, const DatasetOpenOptions& options);
 std::unique_ptr<FrameSource> open_cgsr_release(const std::filesystem::path& root, const DatasetOpenOptions& options);
@@ -166,12 +171,23 @@ bool looks_like_glob_layout(const std::filesystem::path& path);
 // The bsp channel (render_channels.h) is derived on load when asked for (and by default when the
 // data set has BSP border files); asked for without them it is an error naming the data set and
 // how to render them.
+// The history channel (render_channels.h, history_channel.h) is derived only when asked for by
+// name (it reads kHistoryFrames more frames per frame); asked for on data that cannot give it at
+// any resolution it is an error naming the data set, each resolution and what it lacks.
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options);
-// info.derived without bsp: the channels derive_channels computes from depth.
+// info.derived without bsp and history: the channels derive_channels computes from depth.
 std::vector<RenderChannel> depth_derived(const DatasetInfo& info);
+// s when `resolution` is s times resolutions[0] in both axes (s >= 1), else 0.
+int lr_multiple(const DatasetInfo& info, size_t resolution);
 // Whether `resolution` is an integer multiple of the BSP resolution (resolutions[0]) of a data set
 // with BSP border files: where the bsp channel exists.
 bool bsp_available_at(const DatasetInfo& info, size_t resolution);
+// Why the history channel cannot be made at `resolution` ("" when it can): not an integer
+// multiple of resolutions[0], or no motion / depth stored there (or no depth at resolutions[0]).
+std::string history_missing_at(const DatasetInfo& info, size_t resolution);
+bool history_available_at(const DatasetInfo& info, size_t resolution);
+// Whether `frame` has a predecessor in its own scene (Dataset::has_previous).
+bool has_previous_frame(const DatasetInfo& info, int frame);
 const std::vector<RenderChannel>& channels_at(const DatasetInfo& info, size_t resolution);
 
 }  // namespace cgsr

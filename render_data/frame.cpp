@@ -15,6 +15,7 @@ bool Frame::has(RenderChannel c) const {
     case RenderChannel::Edge: return edge.defined();
     case RenderChannel::Motion: return motion.defined();
     case RenderChannel::Bsp: return bsp.defined();
+    case RenderChannel::History: return history.defined();
   }
   return false;
 }
@@ -40,6 +41,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
       case RenderChannel::Edge: parts.push_back(edge.to(torch::kFloat32)); break;
       case RenderChannel::Motion: parts.push_back(motion.to(torch::kFloat32)); break;
       case RenderChannel::Bsp: parts.push_back(bsp); break;
+      case RenderChannel::History: parts.push_back(history); break;
     }
   }
   if (parts.empty()) return torch::zeros({0, height, width}, torch::kFloat32);
@@ -48,7 +50,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
 
 size_t Frame::bytes() const {
   size_t n = 0;
-  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp})
+  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp, &history})
     if (t->defined()) n += t->numel() * t->element_size();
   if (bsp_border) n += bsp_border->bytes();
   return n;
@@ -64,7 +66,7 @@ Frame crop(const Frame& f, int x, int y, int w, int h) {
   for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
                            std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},
                            std::pair{&out.edge, &src->edge}, std::pair{&out.motion, &src->motion},
-                           std::pair{&out.bsp, &src->bsp}})
+                           std::pair{&out.bsp, &src->bsp}, std::pair{&out.history, &src->history}})
     if (from->defined()) *dst = from->slice(1, y, y + h).slice(2, x, x + w);
   return out;
 }

@@ -31,6 +31,9 @@ struct Frame {
   // on load from the LR frame's colour and bsp_border; bsp_channel.h). float32: it is the BSP
   // upsampler's output number for number.
   torch::Tensor bsp;
+  // float32 [4,H,W]: the reprojected LR samples of this frame and its predecessors (render_channels.h,
+  // derived on load from the stored channels of the previous frames; history_channel.h).
+  torch::Tensor history;
   DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
   // The sub-pixel BSP border image, when the data set stores one at this resolution (cgsr data
   // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are

@@ -238,7 +238,8 @@ class GlobDataset : public FrameSource {
         case RenderChannel::Motion:
           f.motion = decode(file(c), "motion", [&](const ImageFile& image) { return decode_capture_motion(image, motion_format_); });
           break;
-        case RenderChannel::Bsp: break;  // never stored: resolve_channels only derives it
+        case RenderChannel::Bsp:  // never stored: resolve_channels only derives them
+        case RenderChannel::History: break;
       }
     }
     return f;

@@ -44,7 +44,8 @@ void require_channels(const Dataset& data, const std::vector<RenderChannel>& cha
       if (std::find(here.begin(), here.end(), c) == here.end())
         throw Error(data.info().root.string(), "batches need channel '" + channel_name(c) + "' at " +
                                                    data.resolutions()[r].name() + ", which the dataset does not provide there" +
-                                                   (here.empty() ? std::string() : " (it has: " + join(channel_names(here)) + ")"));
+                                                   (here.empty() ? std::string() : " (it has: " + join(channel_names(here)) + ")") +
+                                                   (c == RenderChannel::History ? ": " + history_missing_at(data.info(), r) : ""));
   }
 }
 

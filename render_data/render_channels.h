@@ -32,6 +32,19 @@
 //                                 integer multiple of the data set's BSP resolution (at that one:
 //                                 the colour with each border pixel's centre leaf); only cgsr data
 //                                 sets rendered with bsp_border have it
+//   history         4    [0,1]    the jittered LR samples of this frame and of its K = 4 previous
+//                                 frames of the same scene (never across a scene cut), each on this
+//                                 resolution's grid at the point it sampled (LR pixel x of frame f:
+//                                 s * (x + 0.5 - jitter_f), s = this resolution / the LR one, an
+//                                 integer), reprojected to this frame by gathering through the
+//                                 motion vectors and rejected where its depth disagrees
+//                                 (disocclusion): (r, g, b) the sample's colour (sRGB-encoded like
+//                                 the colour image), then recency 1 for this frame's sample,
+//                                 1 - k/(K+1) for frame t-k's, 0 where none lands (colour 0); the
+//                                 most recent sample wins. Derived on load (history_channel.h) only
+//                                 when asked for by name, at every integer multiple of the LR
+//                                 resolution where motion and depth are stored (and LR depth);
+//                                 docs/temporal.md
 
 #include <torch/types.h>
 
@@ -42,7 +55,7 @@
 
 namespace cgsr {
 
-enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp };
+enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp, History };
 
 const std::vector<RenderChannel>& all_render_channels();  // in the fixed order above
 const std::string& channel_name(RenderChannel channel);

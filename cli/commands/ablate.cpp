@@ -35,7 +35,10 @@ void setup_ablate(CLI::App& app) {
 }
 
 nlohmann::ordered_json run_ablate(const AblateOptions& options, RunDir& run_dir) {
-  const Dataset data = Dataset::open(options.data);
+  std::vector<RenderChannel> channels = parse_channels(options.ablation.rit.channels);
+  for (const auto& set : options.ablation.channel_sets)
+    for (auto c : parse_channels(set)) channels.push_back(c);
+  const Dataset data = open_with_asked_channels(options.data, channels);
   const Model parent = load_model(options.model);
   const AblationResult result = run_ablation(*parent.network, data, options.ablation, run_dir.path());
   const std::string markdown = ablation_markdown(result);
