@@ -20,6 +20,7 @@
 
 namespace cgsr {
 namespace bsp_channel_test {  // named: the tests compile as one unity translation unit
+using test::with_channels;
 
 // The tiny procedural room (64x48 and 128x96) with BSP border files, rendered once per process.
 const std::filesystem::path& tiny_bsp_data() {
@@ -32,12 +33,6 @@ const std::filesystem::path& tiny_bsp_data() {
     return d;
   }();
   return dir;
-}
-
-DatasetOpenOptions with_channels(std::vector<std::string> channels) {
-  DatasetOpenOptions o;
-  o.channels = std::move(channels);
-  return o;
 }
 
 TEST(BspChannel, IsTheUpsamplersOutputAndItsBorderCoverage) {

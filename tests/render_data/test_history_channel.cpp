@@ -23,9 +23,11 @@
 #include "render_data/jitter.h"
 #include "test_scenes.h"
 #include "tests/support/cli_runner.h"
+#include "tests/support/tiny_data.h"
 
 namespace cgsr {
 namespace history_channel_test {  // named: the tests compile as one unity translation unit
+using test::with_channels;
 namespace fs = std::filesystem;
 
 std::string tiny_config() { return std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml"; }
@@ -48,12 +50,6 @@ const fs::path& jittered_data() {
     return d;
   }();
   return dir;
-}
-
-DatasetOpenOptions with_channels(std::vector<std::string> channels) {
-  DatasetOpenOptions o;
-  o.channels = std::move(channels);
-  return o;
 }
 
 // Frame t's chain as the data set gathers it: frames[k] = frame t-k (k <= kHistoryFrames).

@@ -164,9 +164,7 @@ TEST(Jitter, OffsetsRoundTripThroughTheManifest) {
 
 TEST(Jitter, MalformedOffsetsNameTheManifestAndKey) {
   const fs::path dir = test::temp_dir("jitter_bad");
-  const std::string head = "format: cgsr-dataset\nversion: 1\nname: x\ncomplete: true\nfingerprint: a\nframes: 2\n"
-                           "resolutions: [32x24, 64x48]\nnear: 0.1\nfar: 10\nsplit: {train: [0, 1], val: [], test: []}\n";
-  const std::pair<std::string, std::string> cases[] = {
+  test::expect_manifest_errors(dir, {
       {"jitter: {resolution: 32x24, sequence: halton, phases: 8, offsets: [[0, 0.1]]}", "has 1 offsets for 2 frames"},
       {"jitter: {resolution: 32x24, sequence: halton, phases: 8, offsets: [[0, 0.1], [0.5, 0]]}",
        "outside [-0.5, 0.5) pixels"},
@@ -174,19 +172,7 @@ TEST(Jitter, MalformedOffsetsNameTheManifestAndKey) {
        "only the smallest resolution"},
       {"jitter: {resolution: 32x24, sequence: sobol, phases: 8, offsets: [[0, 0], [0, 0]]}", "unknown jitter sequence"},
       {"jitter: {resolution: 32x24, phases: 8, offsets: [[0, 0], [0, 0]]}", "missing required key 'sequence'"},
-  };
-  for (const auto& [block, message] : cases) {
-    std::ofstream(dir / "manifest.yaml", std::ios::trunc) << head << block << "\n";
-    try {
-      read_manifest(dir);
-      ADD_FAILURE() << "expected an error for " << block;
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("manifest.yaml:11"), std::string::npos) << what;
-      EXPECT_NE(what.find("jitter"), std::string::npos) << what;
-      EXPECT_NE(what.find(message), std::string::npos) << what;
-    }
-  }
+  }, "manifest.yaml:11", "jitter");
 }
 
 // A jittered render: the smallest resolution's frames carry their offsets through the data set

@@ -5,9 +5,16 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 #include "core/config.h"
+#include "core/error.h"
+#include "render_data/dataset_manifest.h"
 #include "render_data/render_job.h"
 #include "render_data/renderer.h"
 #include "render_data/scene.h"
@@ -138,6 +145,33 @@ DatasetManifest write_test_dataset(const std::filesystem::path& dir, int frames,
     for (const auto& r : resolutions) write_frame_files(dir, r, f, make(f, r));
   write_manifest(dir, m);
   return m;
+}
+
+// A two-frame manifest's fixed part (32x24 and 64x48), to which a test appends one block.
+inline const std::string& manifest_head() {
+  static const std::string head =
+      "format: cgsr-dataset\nversion: 1\nname: x\ncomplete: true\nfingerprint: a\nframes: 2\n"
+      "resolutions: [32x24, 64x48]\nnear: 0.1\nfar: 10\nsplit: {train: [0, 1], val: [], test: []}\n";
+  return head;
+}
+
+// Each (block, message): manifest_head() plus the block must fail to read with an error that names
+// the manifest at `at` ("manifest.yaml:11"), contains `key` and the message.
+inline void expect_manifest_errors(const std::filesystem::path& dir,
+                                   const std::vector<std::pair<std::string, std::string>>& cases,
+                                   const std::string& at, const std::string& key) {
+  for (const auto& [block, message] : cases) {
+    std::ofstream(dir / "manifest.yaml", std::ios::trunc) << manifest_head() << block << "\n";
+    try {
+      read_manifest(dir);
+      ADD_FAILURE() << "expected an error for " << block;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(at), std::string::npos) << what;
+      EXPECT_NE(what.find(key), std::string::npos) << what;
+      EXPECT_NE(what.find(message), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace cgsr::test

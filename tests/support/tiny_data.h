@@ -4,9 +4,12 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "render_data/dataset.h"
 #include "tests/support/cli_runner.h"
 
 namespace cgsr::test {
@@ -20,6 +23,13 @@ inline const std::filesystem::path& tiny_data() {
     return d;
   }();
   return dir;
+}
+
+// Opening options that load exactly these channels.
+inline DatasetOpenOptions with_channels(std::vector<std::string> channels) {
+  DatasetOpenOptions o;
+  o.channels = std::move(channels);
+  return o;
 }
 
 }  // namespace cgsr::test
