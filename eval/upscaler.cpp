@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "eval/baselines/bsp_border_upsampler.h"
 #include "eval/baselines/fsr1.h"
+#include "eval/baselines/history_fill.h"
 #include "eval/baselines/interpolation.h"
 #include "models/inference.h"
 
@@ -48,6 +49,43 @@ class BspBorderUpscaler : public Upscaler {
   int scale_;
 };
 
+// Bicubic at the unjittered output grid, from each frame's jitter (Batch::lr_jitter; an engine
+// knows its jitter); plain bicubic for batches without one.
+class JitteredBicubicUpscaler : public Upscaler {
+ public:
+  explicit JitteredBicubicUpscaler(int scale) : scale_(scale) {}
+  std::string name() const override { return "bicubic_at_jitter"; }
+  int scale() const override { return scale_; }
+  torch::Tensor upscale(const Batch& batch) override {
+    torch::NoGradGuard no_grad;
+    return batch.lr_jitter.empty() ? upscale_bicubic(batch.lr_color, scale_)
+                                   : upscale_bicubic_jittered(batch.lr_color, scale_, batch.lr_jitter);
+  }
+
+ private:
+  int scale_;
+};
+
+// The history-fill upscaler: the batch's `history` channel at the output resolution.
+class HistoryFillUpscaler : public Upscaler {
+ public:
+  explicit HistoryFillUpscaler(int scale) : scale_(scale) {}
+  std::string name() const override { return "history"; }
+  int scale() const override { return scale_; }
+  std::vector<RenderChannel> channels() const override { return {RenderChannel::History}; }
+  torch::Tensor upscale(const Batch& batch) override {
+    torch::NoGradGuard no_grad;
+    if (!batch.hr_info.defined() || batch.hr_info.numel() == 0)
+      throw Error("history", "the frames carry no history channel at the output resolution: evaluate it on a data set "
+                             "with motion and depth at that resolution (docs/temporal.md)");
+    const auto history = pick_channels(batch.hr_info, batch.channels, channels(), "hr_info", "the history upscaler");
+    return upscale_history_fill(batch.lr_color, history, scale_, batch.lr_jitter);
+  }
+
+ private:
+  int scale_;
+};
+
 void add_classic(Registry<ClassicFactory>& r, const std::string& name, ClassicUpscaler::Function f,
                  const std::string& description) {
   r.add(name, [name, f](int scale) { return std::make_unique<ClassicUpscaler>(name, scale, f); }, description);
@@ -65,6 +103,10 @@ const Registry<ClassicFactory>& classic_upscalers() {
                 "FSR 1.0-style EASU + RCAS");
     r.add("bsp_border", [](int scale) { return std::make_unique<BspBorderUpscaler>(scale); },
           "leaves of the renderer's sub-pixel BSP border images, bicubic elsewhere (data sets rendered with bsp_border)");
+    r.add("bicubic_at_jitter", [](int scale) { return std::make_unique<JitteredBicubicUpscaler>(scale); },
+          "bicubic at the unjittered output grid, from each frame's jitter (bicubic on unjittered frames)");
+    r.add("history", [](int scale) { return std::make_unique<HistoryFillUpscaler>(scale); },
+          "the reprojected samples of the history channel where it has one, bicubic elsewhere (data sets with motion)");
     return r;
   }();
   return registry;

@@ -5,6 +5,7 @@
 
 #include <torch/types.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -26,6 +27,9 @@ struct Batch {
   // Whole frames of a data set with sub-pixel BSP border files: each item's LR BSP border image
   // (frame_batch fills it; empty for patches and for data sets without them).
   std::vector<std::shared_ptr<const BspBorderImage>> lr_bsp_border;
+  // Whole frames: each item's LR jitter (Frame::jitter, LR pixels; frame_batch fills it; empty for
+  // patches, whose augmentation would have to move it too).
+  std::vector<std::array<double, 2>> lr_jitter;
 };
 
 }  // namespace cgsr

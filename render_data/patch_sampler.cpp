@@ -254,6 +254,7 @@ Batch frame_batch(const Dataset& data, int frame, int scale, const std::vector<R
                                     scene.far_plane, nullptr)};
   Batch b = stack(items, channels, depth, {frame}, scale);
   if (l->bsp_border) b.lr_bsp_border.push_back(l->bsp_border);
+  b.lr_jitter.push_back(l->jitter);
   return b;
 }
 

@@ -140,6 +140,28 @@ torch::Tensor upscale_bicubic(const torch::Tensor& lr, int scale) {
                                 .align_corners(false));
 }
 
+torch::Tensor upscale_bicubic_jittered(const torch::Tensor& lr, int scale, const std::vector<std::array<double, 2>>& jitter) {
+  check_input(lr, scale);
+  if (static_cast<int64_t>(jitter.size()) != lr.size(0))
+    throw Error("bicubic", "one jitter per item needed: " + std::to_string(lr.size(0)) + " items, " +
+                               std::to_string(jitter.size()) + " jitters");
+  const int64_t h = lr.size(2), w = lr.size(3), H = h * scale, W = w * scale;
+  // grid_sample's coordinates (align_corners = false): -1 and 1 are the outer edges of the input.
+  const auto normalized = [scale](int64_t out, int64_t in, double offset) {
+    return (2 * ((torch::arange(out, torch::kFloat64) + 0.5) / scale + offset) / in - 1).to(torch::kFloat32);
+  };
+  std::vector<torch::Tensor> grids;
+  for (const auto& j : jitter) {
+    const auto gx = normalized(W, w, j[0]).view({1, W}).expand({H, W});
+    const auto gy = normalized(H, h, j[1]).view({H, 1}).expand({H, W});
+    grids.push_back(torch::stack({gx, gy}, -1));
+  }
+  // Bicubic (mode 2) with border padding (1), which clamps each tap and so replicates the edge as
+  // upscale_bicubic does; the functional API of LibTorch 1.13 offers no bicubic mode.
+  return torch::grid_sampler(lr.to(torch::kFloat32), torch::stack(grids), /*interpolation_mode=*/2,
+                             /*padding_mode=*/1, /*align_corners=*/false);
+}
+
 torch::Tensor resampling_matrix(int64_t in_size, int64_t out_size, double support,
                                 const std::function<double(double)>& kernel) {
   auto m = torch::zeros({out_size, in_size}, torch::kFloat64);

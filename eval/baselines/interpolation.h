@@ -4,11 +4,18 @@
 
 #include <torch/types.h>
 
+#include <array>
+#include <vector>
+
 namespace cgsr {
 
 torch::Tensor upscale_nearest(const torch::Tensor& lr, int scale);
 torch::Tensor upscale_bilinear(const torch::Tensor& lr, int scale);
 torch::Tensor upscale_bicubic(const torch::Tensor& lr, int scale);  // Keys cubic, a = -0.75
+// Bicubic of a jittered LR frame (render_data/jitter.h: its content sits at p + jitter) at the
+// unjittered output grid: output pixel j samples the input at (j + 0.5) / scale - 0.5 + jitter.
+// jitter: one (x, y) offset per item, in LR pixels. At jitter 0 it is upscale_bicubic.
+torch::Tensor upscale_bicubic_jittered(const torch::Tensor& lr, int scale, const std::vector<std::array<double, 2>>& jitter);
 // Lanczos (lobes >= 1): 2 * lobes taps per output along each axis, applied as two banded passes
 // (rows, then columns) in the input's precision (float for half/bfloat16), CPU only. The result
 // is the dense product resampling_matrix(rows) @ lr @ resampling_matrix(cols)^T up to float

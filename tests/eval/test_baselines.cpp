@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/error.h"
 #include "eval/baselines/fsr1.h"
 #include "eval/baselines/interpolation.h"
 
@@ -50,6 +51,20 @@ TEST(Baselines, TinyInputsStayFinite) {
         const auto sr = upscale(torch::rand({1, 3, size, size}), scale);
         EXPECT_TRUE(torch::isfinite(sr).all().item<bool>()) << name << " " << size << "px x" << scale;
       }
+}
+
+TEST(Baselines, BicubicAtTheJitterIsBicubicOfTheUnjitteredImage) {
+  const auto lr = torch::rand({2, 3, 9, 11});
+  // No jitter: upscale_bicubic, edges included.
+  EXPECT_LT((upscale_bicubic_jittered(lr, 2, {{0, 0}, {0, 0}}) - upscale_bicubic(lr, 2)).abs().max().item<float>(), 1e-5);
+  // A frame jittered by a whole LR pixel is the unjittered one shifted: content at p + 1 in x.
+  const auto shifted = torch::cat({lr.slice(3, 0, 1), lr.slice(3, 0, 10)}, 3);  // shifted[x] = lr[x - 1]
+  const auto at_jitter = upscale_bicubic_jittered(shifted, 2, {{1, 0}, {1, 0}});
+  const auto plain = upscale_bicubic(lr, 2);
+  // Up to the last 5 output columns, whose taps reach the column the shift dropped, the two agree.
+  EXPECT_LT((at_jitter - plain).slice(3, 0, 17).abs().max().item<float>(), 1e-5);
+  EXPECT_GT((at_jitter - plain).slice(3, 17).abs().max().item<float>(), 1e-3);
+  EXPECT_THROW(upscale_bicubic_jittered(lr, 2, {{0, 0}}), Error);  // one jitter per item
 }
 
 TEST(Baselines, NearestReplicatesPixels) {
