@@ -14,7 +14,7 @@ namespace cgsr::test {
 
 struct SvgPath {
   bool stroked = false, dashed = false;
-  bool straight = false;             // straight segments only (M and L): a line, not a marker
+  bool straight = false;             // straight segments only (M, L, Z): a line or box, not a round marker
   Rgb stroke{-1, -1, -1};            // the stroke colour, 0..255 (-1 when not stroked)
   std::vector<double> xs, ys;        // the coordinates of a polyline ("M x y L x y ...")
   std::vector<std::string> numbers;  // every number in `d` as written
@@ -34,7 +34,7 @@ inline std::vector<SvgPath> svg_paths(const std::string& svg) {
       for (int c = 0; c < 3; ++c) p.stroke[c] = static_cast<int>(std::lround(std::stod(m[c + 1]) * 2.55));
     }
     p.dashed = style.find("stroke-dasharray") != std::string::npos;
-    p.straight = d.find_first_not_of("ML0123456789.-+eE ") == std::string::npos;
+    p.straight = d.find_first_not_of("MLZ0123456789.-+eE ") == std::string::npos;
     std::vector<double> values;
     for (auto n = std::sregex_iterator(d.begin(), d.end(), number); n != std::sregex_iterator(); ++n) {
       p.numbers.push_back(n->str());
