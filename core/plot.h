@@ -1,8 +1,9 @@
 #pragma once
 // Plots on a Canvas (Cairo; PNG, SVG or PDF by the file's extension): scatter plots of quality
 // against cost for reports and search histories, line plots of a figure along a sequence (PSNR
-// per frame, with the scene cuts), grouped bar charts with error bars for ablations. Every point label is placed where it overlaps no other text or marker and stays
-// inside the plot; one that finds no such place is numbered and spelled out in the legend.
+// per frame, with the scene cuts), grouped bar charts with error bars for ablations. Every point
+// label is placed where it overlaps no other text or marker and stays inside the plot; one that
+// finds no such place is numbered and spelled out in the legend.
 
 #include <filesystem>
 #include <memory>

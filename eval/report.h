@@ -7,7 +7,8 @@
 // The report of run directories (`cgsr report`, the report stage of `cgsr run`): the
 // evaluations of their results.json files, collected, written as report.md, report.csv, a plot
 // per table and its PSNR per frame (frame_plot.h), a pattern-choice section per model that
-// chooses a pattern per frame (pattern_choice.h), image comparisons when given, and the same as one HTML page.
+// chooses a pattern per frame (pattern_choice.h), image comparisons when given, and the same as
+// one HTML page.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -71,10 +72,10 @@ ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles = {})
 std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs);
 
 // Writes report.md, report.csv, index.html (report_page.h) and per (scene, scale) a plot of PSNR
-// against latency and one of PSNR per frame (frame_plot.h), as PNG and SVG, into `run_dir`, and prints the tables; the results it returns carry the
-// evaluations again, so a report can be reported on. The tables of `heldout_scenes` (data set
-// names) are headed as scenes not in the training data. `comparisons` were written into
-// run_dir/images (image_comparison.h).
+// against latency and one of PSNR per frame (frame_plot.h), as PNG and SVG, into `run_dir`, and
+// prints the tables; the results it returns carry the evaluations again, so a report can be
+// reported on. The tables of `heldout_scenes` (data set names) are headed as scenes not in the
+// training data. `comparisons` were written into run_dir/images (image_comparison.h).
 nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
                                     const std::vector<std::string>& heldout_scenes = {},
                                     const ReportRoles& roles = {},

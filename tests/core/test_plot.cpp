@@ -101,7 +101,8 @@ TEST(LinePlot, LabelsNeverOverlapOrLeaveTheCanvas) {
   plot.x_label = "frame (index in the data set)";
   plot.y_label = "PSNR (dB)";
   plot.integer_x = true;
-  for (int scene = 0; scene < 12; ++scene) plot.regions.push_back({scene * 40.0, "a long scene name " + std::to_string(scene)});
+  for (int scene = 0; scene < 12; ++scene)
+    plot.regions.push_back({scene * 40.0, "a long scene name " + std::to_string(scene)});
   plot.boundary_name = "scene cut (the history starts again)";
   plot.notes = {"hollow on the top edge: PSNR +inf (identical)"};
   for (const std::string name : {"bicubic", "CG-optimized PAN x2 hybrid"}) {

@@ -215,8 +215,8 @@ TEST(Report, NoPsnrPerFrameForASingleFrame) {
 // with every coordinate of the SVG finite, also when every frame of a model is identical.
 TEST(Report, InfinitePsnrPerFrameStaysOnThePlot) {
   const std::vector<SceneStart> scenes = {{"hall", 0}};
-  ReportTable t{"set", 2, {scored("nearest", {0, 1, 2, 3}, scenes, {2}), scored("copy", {0, 1, 2, 3}, scenes, {0, 1, 2, 3})},
-                ""};
+  ReportTable t{"set", 2,
+                {scored("nearest", {0, 1, 2, 3}, scenes, {2}), scored("copy", {0, 1, 2, 3}, scenes, {0, 1, 2, 3})}, ""};
   const auto plot = psnr_per_frame_plot(t);
   ASSERT_TRUE(plot.has_value());
   EXPECT_TRUE(std::any_of(plot->notes.begin(), plot->notes.end(),
@@ -273,9 +273,8 @@ TEST(Report, WriteReportDrawsPsnrPerFrame) {
   single.dataset = "yard";
   {
     RunDir run(dir, /*own_log=*/false);
-    const auto results = write_report({scored("bicubic", {0, 1, 2}, {{"hall", 0}}), scored("pan", {0, 1, 2}, {{"hall", 0}}),
-                                       single},
-                                      run);
+    const auto results =
+        write_report({scored("bicubic", {0, 1, 2}, {{"hall", 0}}), scored("pan", {0, 1, 2}, {{"hall", 0}}), single}, run);
     ASSERT_EQ(results.at("tables").size(), 2u);
     EXPECT_EQ(results["tables"][0].at("frame_plot_svg"), "psnr_per_frame_hall_x2.svg");
     EXPECT_EQ(results["tables"][0].at("frame_plot"), "psnr_per_frame_hall_x2.png");
