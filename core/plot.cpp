@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.h"
 
@@ -39,7 +40,8 @@ std::vector<double> ticks(double lo, double hi, bool log_scale) {
       break;
     }
   // Multiples of the step, so that 0 is exactly 0 (not the residue of repeated additions).
-  for (double k = std::ceil(lo / step); k * step <= hi + 1e-12; k += 1) out.push_back(k * step);
+  // + 0.0 turns -0 (from ceil of a small negative) into 0, which prints without a sign.
+  for (double k = std::ceil(lo / step); k * step <= hi + 1e-12; k += 1) out.push_back(k * step + 0.0);
   return out;
 }
 
@@ -83,6 +85,93 @@ Point2 nearest_on(const Box& box, Point2 p) {
   return {std::clamp(p.x, box.x0, box.x1), std::clamp(p.y, box.y0, box.y1)};
 }
 
+// The plot area and its axes: the margins hold the tick labels and the axis titles, the area
+// is plot_w x plot_h pixels, and px/py map data to canvas pixels. Shared by the scatter and
+// line plots; the caller sizes the canvas from its legend (canvas_size) and draws the axes.
+struct Axes {
+  Box area;
+  double x_lo = 0, x_hi = 1, y_lo = 0, y_hi = 1;  // padded; log10 values on a log axis
+  bool log_x = false;
+  std::vector<double> x_ticks, y_ticks;
+  double line_height = 0;  // of a legend line
+
+  double px(double x) const {
+    const double v = log_x ? std::log10(std::max(x, 1e-12)) : x;
+    return area.x0 + (v - x_lo) / (x_hi - x_lo) * area.width();
+  }
+  double py(double y) const { return area.y1 - (y - y_lo) / (y_hi - y_lo) * area.height(); }
+  double bottom_margin() const {
+    Canvas probe(1, 1);
+    return 8 + probe.measure("Ag", kTick).height() + 10 + probe.measure("Ag", kAxis).height() + 14;
+  }
+  // The canvas: the area and its margins, the legend column right of it (`legend_width` wide,
+  // `legend_lines` lines, next to a 30 px sample), and as tall as the taller of the two.
+  std::pair<int, int> canvas_size(double legend_width, size_t legend_lines) const {
+    const double height = std::max(area.y1 + bottom_margin(), area.y0 + 10 + line_height * legend_lines + 10);
+    const double width = area.x1 + 24 + 30 + legend_width + 16;
+    return {static_cast<int>(std::ceil(width)), static_cast<int>(std::ceil(height))};
+  }
+};
+
+// `xs` (log10 values on a log axis) and `ys` must not be empty; `x_margin` is the share of the
+// x range left free at each end.
+Axes layout_axes(const std::vector<double>& xs, const std::vector<double>& ys, bool log_x, double plot_w,
+                 double plot_h, double x_margin = 0.08) {
+  Axes a;
+  a.log_x = log_x;
+  const double x_min = *std::min_element(xs.begin(), xs.end()), x_max = *std::max_element(xs.begin(), xs.end());
+  const double x_pad = x_max > x_min ? x_margin * (x_max - x_min) : 0.5;
+  a.x_lo = x_min - x_pad;
+  a.x_hi = x_max + x_pad;
+  std::tie(a.y_lo, a.y_hi) = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
+  a.x_ticks = ticks(a.x_lo, a.x_hi, log_x);
+  a.y_ticks = ticks(a.y_lo, a.y_hi, false);
+  Canvas probe(1, 1);
+  double y_tick_width = 0;
+  for (double v : a.y_ticks) y_tick_width = std::max(y_tick_width, probe.measure(tick_text(v), kTick).width());
+  a.line_height = probe.measure("Ag", kLegend).height() + 5;
+  const double left = 14 + probe.measure("Ag", kAxis).height() + 10 + y_tick_width + 8;
+  const double top = 16 + probe.measure("Ag", kTitle).height() + 14;
+  a.area = {left, top, left + plot_w, top + plot_h};
+  return a;
+}
+
+// Title, axis titles, grid, tick labels and the frame round the area.
+void draw_axes(Canvas& c, const Axes& a, const std::string& title, const std::string& x_label,
+               const std::string& y_label) {
+  Canvas probe(1, 1);
+  const double tick_height = probe.measure("Ag", kTick).height();
+  c.text({a.area.x0 + a.area.width() / 2, 16 + probe.measure("Ag", kTitle).height() - 4}, title, kTitle,
+         Anchor::Centre);
+  c.vertical_text({14 + probe.measure("Ag", kAxis).height() / 2, a.area.y0 + a.area.height() / 2}, y_label, kAxis);
+  c.text({a.area.x0 + a.area.width() / 2, c.height() - 12.0}, x_label, kAxis, Anchor::Centre);
+  for (double v : a.x_ticks) {
+    c.line({a.px(v), a.area.y0}, {a.px(v), a.area.y1}, kGrid);
+    tick_label(c, {a.px(v), a.area.y1 + 8 + tick_height - 3}, tick_text(v), Anchor::Centre);
+  }
+  for (double v : a.y_ticks) {
+    c.line({a.area.x0, a.py(v)}, {a.area.x1, a.py(v)}, kGrid);
+    tick_label(c, {a.area.x0 - 6, a.py(v) + 4}, tick_text(v), Anchor::Right);
+  }
+  c.rectangle(a.area, kFrame, false);
+}
+
+// The legend column right of the area: each entry a 22 px sample (drawn by the caller at
+// sample()) and its text.
+struct Legend {
+  Canvas& c;
+  double x, y, line_height;
+  Legend(Canvas& canvas, const Axes& a) : c(canvas), x(a.area.x1 + 24), y(a.area.y0 + 10 + a.line_height / 2),
+                                          line_height(a.line_height) {}
+  Point2 sample_start() const { return {x, y}; }
+  Point2 sample_end() const { return {x + 22, y}; }
+  Point2 sample_centre() const { return {x + 11, y}; }
+  void text(const std::string& t) {
+    c.text({x + 30, y + 4}, t, kLegend);
+    y += line_height;
+  }
+};
+
 struct PlacedLabel {
   std::string text;
   Point2 at;    // the marker
@@ -102,15 +191,13 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
   for (const auto& [y, text] : plot.horizontal_lines) ys.push_back(y);
   if (ys.empty()) throw Error("plot '" + plot.title + "'", "nothing to plot");
   if (xs.empty()) xs = {0.0, 1.0};
-  const auto [x_lo, x_hi] = padded(*std::min_element(xs.begin(), xs.end()), *std::max_element(xs.begin(), xs.end()));
-  const auto [y_lo, y_hi] = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
-  const auto x_ticks = ticks(x_lo, x_hi, plot.log_x), y_ticks = ticks(y_lo, y_hi, false);
+  const Axes axes = layout_axes(xs, ys, plot.log_x, 640, 460);
+  const Box& area = axes.area;
+  auto px = [&](double x) { return axes.px(x); };
+  auto py = [&](double y) { return axes.py(y); };
 
-  // Margins from the text they hold; the legend column from its longest entry.
+  // The legend column from its longest entry.
   Canvas probe(1, 1);
-  double y_tick_width = 0;
-  for (double v : y_ticks) y_tick_width = std::max(y_tick_width, probe.measure(tick_text(v), kTick).width());
-  const double line_height = probe.measure("Ag", kLegend).height() + 5;
   std::vector<std::string> legend_texts;
   for (const auto& [y, text] : plot.horizontal_lines) legend_texts.push_back(text);
   for (const auto& s : plot.series)
@@ -119,17 +206,6 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
   double legend_width = 0;
   for (const auto& t : legend_texts) legend_width = std::max(legend_width, probe.measure(t, kLegend).width());
   for (const auto& t : plot.notes) legend_width = std::max(legend_width, probe.measure(t, kLegend).width());
-
-  const double plot_w = 640, plot_h = 460;
-  const double left = 14 + probe.measure("Ag", kAxis).height() + 10 + y_tick_width + 8;
-  const double top = 16 + probe.measure("Ag", kTitle).height() + 14;
-  const double bottom = 8 + probe.measure("Ag", kTick).height() + 10 + probe.measure("Ag", kAxis).height() + 14;
-  const Box area{left, top, left + plot_w, top + plot_h};
-  auto px = [&, x_lo = x_lo, x_hi = x_hi](double x) {
-    const double v = plot.log_x ? std::log10(std::max(x, 1e-12)) : x;
-    return area.x0 + (v - x_lo) / (x_hi - x_lo) * plot_w;
-  };
-  auto py = [&, y_lo = y_lo, y_hi = y_hi](double y) { return area.y1 - (y - y_lo) / (y_hi - y_lo) * plot_h; };
 
   // Every point label, placed before anything is drawn: the ones with no free place become
   // numbers, spelled out in the legend, which may then need more height.
@@ -164,35 +240,17 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
   for (const auto& n : numbered) legend_width = std::max(legend_width, probe.measure(n, kLegend).width());
 
   const size_t legend_lines = legend_texts.size() + plot.notes.size() + numbered.size();
-  const double height = std::max(top + plot_h + bottom, top + 10 + line_height * legend_lines + 10);
-  const double width = left + plot_w + 24 + 30 + legend_width + 16;
-  auto canvas = std::make_unique<Canvas>(static_cast<int>(std::ceil(width)), static_cast<int>(std::ceil(height)));
+  const auto [width, height] = axes.canvas_size(legend_width, legend_lines);
+  auto canvas = std::make_unique<Canvas>(width, height);
   Canvas& c = *canvas;
-
-  c.text({area.x0 + plot_w / 2, 16 + probe.measure("Ag", kTitle).height() - 4}, plot.title, kTitle, Anchor::Centre);
-  c.vertical_text({14 + probe.measure("Ag", kAxis).height() / 2, area.y0 + plot_h / 2}, plot.y_label, kAxis);
-  c.text({area.x0 + plot_w / 2, height - 12}, plot.x_label, kAxis, Anchor::Centre);
-  for (double v : x_ticks) {
-    c.line({px(v), area.y0}, {px(v), area.y1}, kGrid);
-    tick_label(c, {px(v), area.y1 + 8 + probe.measure("Ag", kTick).height() - 3}, tick_text(v), Anchor::Centre);
-  }
-  for (double v : y_ticks) {
-    c.line({area.x0, py(v)}, {area.x1, py(v)}, kGrid);
-    tick_label(c, {area.x0 - 6, py(v) + 4}, tick_text(v), Anchor::Right);
-  }
-  c.rectangle(area, kFrame, false);
+  draw_axes(c, axes, plot.title, plot.x_label, plot.y_label);
 
   // The legend, right of the plot: a sample of each series' line or marker, then the notes.
-  const double lx = area.x1 + 24;
-  double ly = area.y0 + 10 + line_height / 2;
-  auto legend_text = [&](const std::string& text) {
-    c.text({lx + 30, ly + 4}, text, kLegend);
-    ly += line_height;
-  };
+  Legend legend(c, axes);
   for (const auto& [y, text] : plot.horizontal_lines) {
     c.line({area.x0, py(y)}, {area.x1, py(y)}, {120, 120, 120}, 1, true);
-    c.line({lx, ly}, {lx + 22, ly}, {120, 120, 120}, 1, true);
-    legend_text(text);
+    c.line(legend.sample_start(), legend.sample_end(), {120, 120, 120}, 1, true);
+    legend.text(text);
   }
   for (const auto& s : plot.series) {
     if (s.connect && s.points.size() > 1) {
@@ -204,16 +262,16 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
       c.polyline(line, s.colour, 1.5);
     }
     if (s.name.empty()) continue;
-    if (s.connect) c.line({lx, ly}, {lx + 22, ly}, s.colour, 1.5);
-    c.marker({lx + 11, ly}, s.marker, std::min(s.radius, 6.0), s.colour, s.filled);
-    legend_text(s.name);
+    if (s.connect) c.line(legend.sample_start(), legend.sample_end(), s.colour, 1.5);
+    c.marker(legend.sample_centre(), s.marker, std::min(s.radius, 6.0), s.colour, s.filled);
+    legend.text(s.name);
   }
   if (!plot.links.empty() && !plot.links_name.empty()) {
-    c.line({lx, ly}, {lx + 22, ly}, kLink, 1.6, true);
-    legend_text(plot.links_name);
+    c.line(legend.sample_start(), legend.sample_end(), kLink, 1.6, true);
+    legend.text(plot.links_name);
   }
-  for (const auto& note : plot.notes) legend_text(note);
-  for (const auto& n : numbered) legend_text(n);
+  for (const auto& note : plot.notes) legend.text(note);
+  for (const auto& n : numbered) legend.text(n);
 
   // Links over the series' lines (a pair often lies along the Pareto front), under the markers.
   for (const auto& link : plot.links) c.line({px(link.x0), py(link.y0)}, {px(link.x1), py(link.y1)}, kLink, 1.6, true);
@@ -230,6 +288,109 @@ std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot) {
 void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot) {
   draw_scatter_plot(plot)->save(path);
 }
+
+std::unique_ptr<Canvas> draw_line_plot(const LinePlot& plot) {
+  // The axes cover the finite points; infinite y values sit on an edge, so do not stretch them.
+  std::vector<double> xs, ys;
+  for (const auto& s : plot.series)
+    for (const auto& segment : s.segments)
+      for (const auto& p : segment) {
+        if (!std::isfinite(p.x) || std::isnan(p.y)) continue;
+        xs.push_back(p.x);
+        if (std::isfinite(p.y)) ys.push_back(p.y);
+      }
+  if (xs.empty()) throw Error("plot '" + plot.title + "'", "nothing to plot");
+  if (ys.empty()) ys = {0.0};  // every point infinite: they are drawn on the edges
+  // Boundaries lie between points anyway; the first region may begin before the first point.
+  for (size_t r = 1; r < plot.regions.size(); ++r)
+    if (std::isfinite(plot.regions[r].start)) xs.push_back(plot.regions[r].start);
+  // A frame axis runs edge to edge: little room at its ends.
+  Axes axes = layout_axes(xs, ys, false, 860, 360, 0.02);
+  if (plot.integer_x)
+    axes.x_ticks.erase(std::remove_if(axes.x_ticks.begin(), axes.x_ticks.end(),
+                                      [](double v) { return std::abs(v - std::round(v)) > 1e-9; }),
+                       axes.x_ticks.end());
+  const Box& area = axes.area;
+  // y = +inf on the top edge, -inf on the bottom one.
+  const auto at = [&](const Point2& p) {
+    return Point2{axes.px(p.x), std::isinf(p.y) ? (p.y > 0 ? area.y0 : area.y1) : axes.py(p.y)};
+  };
+
+  Canvas probe(1, 1);
+  double legend_width = 0;
+  size_t legend_lines = plot.notes.size();
+  for (const auto& s : plot.series) {
+    legend_width = std::max(legend_width, probe.measure(s.name, kLegend).width());
+    ++legend_lines;
+  }
+  if (!plot.boundary_name.empty()) {
+    legend_width = std::max(legend_width, probe.measure(plot.boundary_name, kLegend).width());
+    ++legend_lines;
+  }
+  for (const auto& t : plot.notes) legend_width = std::max(legend_width, probe.measure(t, kLegend).width());
+  const auto [width, height] = axes.canvas_size(legend_width, legend_lines);
+  auto canvas = std::make_unique<Canvas>(width, height);
+  Canvas& c = *canvas;
+  draw_axes(c, axes, plot.title, plot.x_label, plot.y_label);
+
+  // Region boundaries under the lines, each region's name at the top: across the region where
+  // it fits between its boundaries, else reading upwards along its boundary (narrow regions, a
+  // few frames long), else not at all.
+  const double name_baseline = area.y0 + 4 + probe.measure("Ag", kTick).height() - 3;
+  for (size_t r = 0; r < plot.regions.size(); ++r) {
+    const auto& region = plot.regions[r];
+    if (!std::isfinite(region.start)) continue;
+    const double x = axes.px(std::max(region.start, axes.x_lo));
+    if (r > 0) c.line({x, area.y0}, {x, area.y1}, kLink, 1.2, true);
+    if (plot.regions.size() < 2 || region.name.empty()) continue;
+    Box room = area;
+    room.x0 = x;
+    if (r + 1 < plot.regions.size() && std::isfinite(plot.regions[r + 1].start))
+      room.x1 = std::min(room.x1, axes.px(plot.regions[r + 1].start));
+    const Box across = probe.measure(region.name, kTick, {x + 4, name_baseline}).grown(2);
+    if (across.inside(room) && !collides(across, c.text_boxes())) {
+      c.text({x + 4, name_baseline}, region.name, kTick);
+      continue;
+    }
+    const Box flat = probe.measure(region.name, kTick);
+    const Point2 centre{x + 3 + flat.height() / 2, area.y0 + 4 + flat.width() / 2};
+    const Box along = Box{centre.x - flat.height() / 2, centre.y - flat.width() / 2, centre.x + flat.height() / 2,
+                          centre.y + flat.width() / 2}.grown(1);
+    if (along.inside(room) && !collides(along, c.text_boxes())) c.vertical_text(centre, region.name, kTick);
+  }
+  for (const auto& s : plot.series)
+    for (const auto& segment : s.segments) {
+      std::vector<Point2> line;
+      std::vector<bool> on_edge;  // an infinite y
+      for (const auto& p : segment)
+        if (std::isfinite(p.x) && !std::isnan(p.y)) {
+          line.push_back(at(p));
+          on_edge.push_back(std::isinf(p.y));
+        }
+      if (line.size() == 1) c.marker(line.front(), Marker::Circle, 2.5, s.colour, true);
+      c.polyline(line, s.colour, 1.5);
+      for (size_t i = 0; i < line.size(); ++i)
+        if (on_edge[i])
+          c.marker(line[i], Marker::Circle, 3.5, s.colour, false);
+        else if (s.dots)
+          c.marker(line[i], Marker::Circle, 2, s.colour, true);
+    }
+
+  Legend legend(c, axes);
+  for (const auto& s : plot.series) {
+    c.line(legend.sample_start(), legend.sample_end(), s.colour, 1.5);
+    if (s.dots) c.marker(legend.sample_centre(), Marker::Circle, 2, s.colour, true);
+    legend.text(s.name);
+  }
+  if (!plot.boundary_name.empty()) {
+    c.line(legend.sample_start(), legend.sample_end(), kLink, 1.2, true);
+    legend.text(plot.boundary_name);
+  }
+  for (const auto& note : plot.notes) legend.text(note);
+  return canvas;
+}
+
+void write_line_plot(const std::filesystem::path& path, const LinePlot& plot) { draw_line_plot(plot)->save(path); }
 
 std::unique_ptr<Canvas> draw_bar_chart(const BarChart& chart) {
   std::vector<double> ys = {0.0};

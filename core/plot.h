@@ -1,8 +1,9 @@
 #pragma once
 // Plots on a Canvas (Cairo; PNG, SVG or PDF by the file's extension): scatter plots of quality
-// against cost for reports and search histories, grouped bar charts with error bars for
-// ablations. Every point label is placed where it overlaps no other text or marker and stays
-// inside the plot; one that finds no such place is numbered and spelled out in the legend.
+// against cost for reports and search histories, line plots of a figure along a sequence (PSNR
+// per frame, with the scene cuts), grouped bar charts with error bars for ablations. Every point
+// label is placed where it overlaps no other text or marker and stays inside the plot; one that
+// finds no such place is numbered and spelled out in the legend.
 
 #include <filesystem>
 #include <memory>
@@ -47,6 +48,39 @@ struct ScatterPlot {
 // nothing to draw.
 std::unique_ptr<Canvas> draw_scatter_plot(const ScatterPlot& plot);
 void write_scatter_plot(const std::filesystem::path& path, const ScatterPlot& plot);
+
+// A line plot over an x axis cut into consecutive regions (say, the scenes of a frame sequence).
+// Each series is drawn in segments: a segment is one polyline, and two segments are never joined
+// (a scene cut, missing frames). A segment of one point is drawn as a dot. y = +inf is drawn on
+// the top edge of the plot with a hollow marker (PSNR of identical images), -inf on the bottom
+// edge; NaN points are left out. Every coordinate drawn is finite.
+struct LineSeries {
+  std::string name;  // legend entry
+  Rgb colour{40, 90, 180};
+  std::vector<std::vector<Point2>> segments;  // in data units, each in x order
+  bool dots = false;  // a dot on every point as well (when the points are samples of the axis)
+};
+
+// A region of the x axis from `start` to the next region's start; every region but the first
+// begins with a dashed vertical line. Region names are written at the top of the plot when there
+// are several regions (a name that has no room is left out).
+struct PlotRegion {
+  double start = 0;
+  std::string name;
+};
+
+struct LinePlot {
+  std::string title, x_label, y_label;
+  bool integer_x = false;  // ticks on whole numbers only (frame indices)
+  std::vector<LineSeries> series;
+  std::vector<PlotRegion> regions;  // in x order
+  std::string boundary_name;        // legend entry of the region boundaries ("" = none)
+  std::vector<std::string> notes;   // extra legend lines
+};
+
+// Throws cgsr::Error when there is no point to draw.
+std::unique_ptr<Canvas> draw_line_plot(const LinePlot& plot);
+void write_line_plot(const std::filesystem::path& path, const LinePlot& plot);
 
 struct BarSeries {
   std::string name;  // legend entry

@@ -190,6 +190,9 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   if (!options.save_frames.empty()) std::filesystem::create_directories(options.save_frames);
 
   const auto frames = evaluation_frames(data, options);
+  for (const auto& scene : data.scenes())
+    if (std::any_of(frames.begin(), frames.end(), [&](int f) { return scene.contains(f); }))
+      result.scene_starts.push_back({scene.name, scene.first_frame});
   Progress progress("eval " + result.name, static_cast<int64_t>(frames.size()));
   double psnr_sum = 0, ssim_sum = 0;
   int psnr_count = 0;
@@ -407,6 +410,8 @@ nlohmann::ordered_json to_json(const EvalResult& r) {
     j["params"] = nullptr;
     j["macs"] = nullptr;
   }
+  j["scene_starts"] = nlohmann::ordered_json::array();
+  for (const auto& s : r.scene_starts) j["scene_starts"].push_back({{"scene", s.scene}, {"first_frame", s.first_frame}});
   j["frames"] = nlohmann::ordered_json::array();
   for (const auto& f : r.frames) {
     nlohmann::ordered_json fj;
@@ -463,6 +468,9 @@ EvalResult eval_result_from_json(const nlohmann::ordered_json& j, const std::str
       c.lr_height = r.lr_height;
       r.cost = c;
     }
+    if (j.contains("scene_starts"))  // results from before the field: one scene
+      for (const auto& s : j.at("scene_starts"))
+        r.scene_starts.push_back({s.at("scene").get<std::string>(), s.at("first_frame").get<int>()});
     for (const auto& f : j.at("frames")) {
       FrameScore s;
       s.frame = f.at("frame");

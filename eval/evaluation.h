@@ -46,6 +46,13 @@ struct FrameScore {
   std::optional<PatternChoice> choice;  // Upscaler::frame_choice() of this frame (none for most upscalers)
 };
 
+// Where a scene of the data set begins: the set's index of its first frame, where a temporal
+// upscaler's history starts again (a scene cut).
+struct SceneStart {
+  std::string scene;
+  int first_frame = 0;
+};
+
 struct EvalResult {
   std::string name;
   Precision precision = Precision::Fp32;  // of a network's row ("<network> int8")
@@ -57,6 +64,9 @@ struct EvalResult {
   int scale = 2;
   int64_t lr_width = 0, lr_height = 0;
   std::vector<FrameScore> frames;
+  // The scenes holding evaluated frames, in frame order: which scene each frame belongs to (the
+  // last one starting at or before it). Empty in results written before it: one scene.
+  std::vector<SceneStart> scene_starts;
   double psnr = 0, ssim = 0;  // means over frames (PSNR of identical frames excluded, counted)
   int identical_frames = 0;
   // Means over the frames that have them (infinite values excluded like psnr's; +inf when

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/pareto.h"
 #include "core/text.h"
+#include "eval/frame_plot.h"
 #include "eval/pattern_choice.h"
 #include "eval/report_page.h"
 
@@ -84,6 +85,13 @@ std::vector<ReportTable> group_results(const std::vector<EvalResult>& results) {
     it->rows.push_back(r);
   }
   return tables;
+}
+
+std::string table_file_stem(const std::vector<ReportTable>& tables, size_t i) {
+  const ReportTable& t = tables.at(i);
+  const auto same = std::count_if(tables.begin(), tables.begin() + static_cast<std::ptrdiff_t>(i),
+                                  [&](const ReportTable& o) { return o.dataset == t.dataset && o.scale == t.scale; });
+  return t.dataset + "_x" + std::to_string(t.scale) + (same ? "_" + std::to_string(same + 1) : "");
 }
 
 std::vector<size_t> pareto_front(const ReportTable& table) {
@@ -225,17 +233,16 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
   results["tables"] = nlohmann::ordered_json::array();
   results["pattern_choices"] = nlohmann::ordered_json::array();
   // Each plot as PNG for the Markdown report and as SVG for the page.
+  const auto save_canvas = [&](const std::string& stem, const Canvas& canvas) {
+    canvas.save(run_dir.file(stem + ".png"));
+    canvas.save(run_dir.file(stem + ".svg"));
+  };
   const auto save_plot = [&](const std::string& stem, const ScatterPlot& plot) {
-    const auto canvas = draw_scatter_plot(plot);
-    canvas->save(run_dir.file(stem + ".png"));
-    canvas->save(run_dir.file(stem + ".svg"));
+    save_canvas(stem, *draw_scatter_plot(plot));
   };
   for (size_t ti = 0; ti < tables.size(); ++ti) {
     const ReportTable& t = tables[ti];
-    // A scene and scale measured against another target too has tables of its own: "_2" and on.
-    const auto same = std::count_if(tables.begin(), tables.begin() + static_cast<std::ptrdiff_t>(ti),
-                                    [&](const ReportTable& o) { return o.dataset == t.dataset && o.scale == t.scale; });
-    const std::string stem = t.dataset + "_x" + std::to_string(t.scale) + (same ? "_" + std::to_string(same + 1) : "");
+    const std::string stem = table_file_stem(tables, ti);
     const bool heldout = std::find(heldout_scenes.begin(), heldout_scenes.end(), t.dataset) != heldout_scenes.end();
     if (heldout)
       markdown += "## Held-out scene: " + t.dataset +
@@ -249,12 +256,20 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
       save_plot(plot, report_plot(t, roles));
       markdown += "![PSNR against latency](" + plot + ".png)\n\n";
     }
+    std::string frame_plot;
+    if (const auto per_frame = psnr_per_frame_plot(t)) {
+      frame_plot = psnr_per_frame_plot_name(stem);
+      save_canvas(frame_plot, *draw_line_plot(*per_frame));
+      markdown += "![PSNR per frame](" + frame_plot + ".png)\n\n";
+    }
     results["tables"].push_back({{"dataset", t.dataset},
                                  {"scale", t.scale},
                                  {"target", t.target},
                                  {"rows", t.rows.size()},
                                  {"plot", plot.empty() ? "" : plot + ".png"},
                                  {"plot_svg", plot.empty() ? "" : plot + ".svg"},
+                                 {"frame_plot", frame_plot.empty() ? "" : frame_plot + ".png"},
+                                 {"frame_plot_svg", frame_plot.empty() ? "" : frame_plot + ".svg"},
                                  {"heldout", heldout}});
     // Models that choose a pattern per frame: the choice next to each frame's edge density.
     for (size_t i = 0; i < t.rows.size(); ++i) {

@@ -6,8 +6,9 @@
 //
 // The report of run directories (`cgsr report`, the report stage of `cgsr run`): the
 // evaluations of their results.json files, collected, written as report.md, report.csv, a plot
-// per table, a pattern-choice section per model that chooses a pattern per frame
-// (pattern_choice.h), image comparisons when given, and the same as one HTML page.
+// per table and its PSNR per frame (frame_plot.h), a pattern-choice section per model that
+// chooses a pattern per frame (pattern_choice.h), image comparisons when given, and the same as
+// one HTML page.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -47,6 +48,10 @@ std::vector<ReportCell> report_row(const EvalResult& r, const ReportTable& table
 std::string report_markdown(const ReportTable& table);
 std::string report_csv(const std::vector<ReportTable>& tables);
 
+// The stem of table i's files ("<dataset>_x<scale>"): a scene and scale measured against another
+// target too has tables of its own, "_2" and on.
+std::string table_file_stem(const std::vector<ReportTable>& tables, size_t i);
+
 // Indices of rows on the Pareto front: no other row is both faster and at least as good (PSNR).
 std::vector<size_t> pareto_front(const ReportTable& table);
 
@@ -66,11 +71,11 @@ ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles = {})
 // `cgsr eval`, `cgsr prune` or `cgsr report`), in order.
 std::vector<EvalResult> collect_evaluations(const std::vector<std::string>& runs);
 
-// Writes report.md, report.csv, index.html (report_page.h) and one plot per (scene, scale), as
-// PNG and SVG, into `run_dir`, and prints the tables; the results it returns carry the
-// evaluations again, so a report can be reported on. The tables of `heldout_scenes` (data set
-// names) are headed as scenes not in the training data. `comparisons` were written into
-// run_dir/images (image_comparison.h).
+// Writes report.md, report.csv, index.html (report_page.h) and per (scene, scale) a plot of PSNR
+// against latency and one of PSNR per frame (frame_plot.h), as PNG and SVG, into `run_dir`, and
+// prints the tables; the results it returns carry the evaluations again, so a report can be
+// reported on. The tables of `heldout_scenes` (data set names) are headed as scenes not in the
+// training data. `comparisons` were written into run_dir/images (image_comparison.h).
 nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, RunDir& run_dir,
                                     const std::vector<std::string>& heldout_scenes = {},
                                     const ReportRoles& roles = {},

@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.h"
 #include "core/text.h"
+#include "eval/frame_plot.h"
 #include "eval/image_comparison.h"
 #include "eval/pattern_choice.h"
 #include "eval/report.h"
@@ -175,6 +176,9 @@ void write_report_page(const std::filesystem::path& dir, const nlohmann::ordered
       << table_html(table);
     if (meta && !meta->value("plot_svg", "").empty())
       h << "<img src=\"" << html_escape(meta->value("plot_svg", "")) << "\" alt=\"PSNR against latency\">\n";
+    if (meta && !meta->value("frame_plot_svg", "").empty())
+      h << "<h3>PSNR per frame</h3>\n<img src=\"" << html_escape(meta->value("frame_plot_svg", ""))
+        << "\" alt=\"PSNR per frame\">\n<p class=\"note\">" << html_escape(psnr_per_frame_caption()) << "</p>\n";
     for (const auto& e : choice_meta) {
       if (e.value("dataset", "") != table.dataset || e.value("scale", 0) != table.scale ||
           e.value("target", "") != table.target)

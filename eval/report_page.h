@@ -3,8 +3,9 @@
 // browser with no server, and needing nothing outside the directory (styles and the script that
 // sorts the tables are inline; plots are SVG files, image comparisons PNG files next to it).
 // It holds the verdict with each check's figures (when there is one), every table (sortable by
-// any column), each table's PSNR-latency plot, the image comparisons, and the pattern chosen per
-// frame. A picture that fails to load is reported on the browser's console.
+// any column), each table's PSNR-latency plot and PSNR per frame (frame_plot.h), the image
+// comparisons, and the pattern chosen per frame. A picture that fails to load is reported on the
+// browser's console.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>

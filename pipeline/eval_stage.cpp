@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/metrics.h"
+#include "eval/frame_plot.h"
 #include "eval/report.h"
 #include "eval/report_page.h"
 #include "models/model_file.h"
@@ -178,6 +179,21 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
   const auto tables = group_results(results);
   if (run_dir) write_file_atomic(run_dir->file("summary.csv"), report_csv(tables));
   for (const auto& t : tables) std::printf("%s\n", report_markdown(t).c_str());
+  // Per table, its PSNR per frame as SVG beside results.json, named as the page finds it.
+  json["tables"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < tables.size(); ++i) {
+    std::string frame_plot;
+    const auto per_frame = psnr_per_frame_plot(tables[i]);
+    if (run_dir && per_frame) {
+      frame_plot = psnr_per_frame_plot_name(table_file_stem(tables, i)) + ".svg";
+      write_line_plot(run_dir->file(frame_plot), *per_frame);
+    }
+    json["tables"].push_back({{"dataset", tables[i].dataset},
+                              {"scale", tables[i].scale},
+                              {"target", tables[i].target},
+                              {"rows", tables[i].rows.size()},
+                              {"frame_plot_svg", frame_plot}});
+  }
   json["comparisons"] = nlohmann::ordered_json::array();
   if (run_dir && options.images.frames > 0 && !results.empty())
     for (const auto& c : compare_frames(upscalers, data, results.front(), options.images, run_dir->path() / "images"))

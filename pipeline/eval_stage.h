@@ -1,7 +1,8 @@
 #pragma once
 // The eval job: what `cgsr eval` runs, and the eval and heldout stages of `cgsr run`. Evaluates
 // model files and classic upscalers on a data set split. Writes results.json (one entry per
-// upscaler), a per-frame CSV per upscaler, summary.csv, index.html (report_page.h) and, when
+// upscaler), a per-frame CSV per upscaler, summary.csv, PSNR per frame as SVG per table
+// (frame_plot.h; named in results.json under "tables"), index.html (report_page.h) and, when
 // asked (`images.frames`, `--save-images N`), image comparisons of the frames with the most
 // geometry edges into images/.
 

@@ -3,6 +3,7 @@
 // and no text of a plot overlaps another or leaves the canvas (the label test).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <tuple>
@@ -91,6 +92,35 @@ TEST(ScatterPlot, LabelsNeverOverlapOrLeaveTheCanvas) {
   for (int f = 0; f < 40; ++f) frames.points.push_back({7.0 + 0.01 * (f % 5), 100.0, std::to_string(f)});
   choices.series = {frames};
   expect_readable(*draw_scatter_plot(choices), "pattern choice plot");
+}
+
+// Scenes close together with long names: the names that have no room are left out, none overlaps.
+TEST(LinePlot, LabelsNeverOverlapOrLeaveTheCanvas) {
+  LinePlot plot;
+  plot.title = "corridors x2: PSNR per frame";
+  plot.x_label = "frame (index in the data set)";
+  plot.y_label = "PSNR (dB)";
+  plot.integer_x = true;
+  for (int scene = 0; scene < 12; ++scene)
+    plot.regions.push_back({scene * 40.0, "a long scene name " + std::to_string(scene)});
+  plot.boundary_name = "scene cut (the history starts again)";
+  plot.notes = {"hollow on the top edge: PSNR +inf (identical)"};
+  for (const std::string name : {"bicubic", "CG-optimized PAN x2 hybrid"}) {
+    LineSeries s{name, {40, 90, 180}, {}, false};
+    for (int scene = 0; scene < 12; ++scene) {
+      s.segments.emplace_back();
+      for (int f = scene * 40; f < scene * 40 + 40; ++f) s.segments.back().push_back({double(f), 25 + (f % 7) * 0.3});
+    }
+    s.segments.back().back().y = INFINITY;
+    plot.series.push_back(s);
+  }
+  const auto canvas = draw_line_plot(plot);
+  expect_readable(*canvas, "line plot");
+  EXPECT_GT(canvas->text_boxes().size(), 12u);  // some scene names were written
+
+  LinePlot empty = plot;
+  for (auto& s : empty.series) s.segments = {{{NAN, 3.0}}};
+  EXPECT_THROW(draw_line_plot(empty), Error);
 }
 
 TEST(BarChart, LabelsNeverOverlapOrLeaveTheCanvas) {

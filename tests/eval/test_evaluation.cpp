@@ -4,14 +4,17 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
 
 #include "core/error.h"
 #include "eval/evaluation.h"
+#include "eval/frame_plot.h"
 #include "eval/report.h"
 #include "render_data/patch_sampler.h"
+#include "tests/support/svg_paths.h"
 #include "tests/support/tiny_data.h"
 
 using namespace cgsr;
@@ -298,18 +301,29 @@ TEST(Evaluation, TimingShowsEachFrameItsPredecessor) {
   EXPECT_EQ(timing, (std::vector<int>{-2, 3, -3, 4, -2, 3, -3, 4, -2, 3}));
 }
 
+namespace {
+// The tiny scene twice, as scenes "tiny" and "tiny_b" of one data set (6 frames each), rendered
+// once per test process.
+const std::filesystem::path& two_scene_set() {
+  static const std::filesystem::path set = [] {
+    const auto dir = scratch_dir("eval-two-scenes");
+    std::string second = slurp(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
+    second.replace(second.find("name: tiny\n"), 11, "name: tiny_b\n");
+    std::ofstream(dir / "tiny_b.yaml") << second;
+    const auto render = run_cgsr("render --scene " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --scene " +
+                                 (dir / "tiny_b.yaml").string() + " --out " + (dir / "set").string() + " --threads 1");
+    EXPECT_EQ(render.exit_code, 0) << render.err;
+    return dir / "set";
+  }();
+  return set;
+}
+}  // namespace
+
 // A multi-scene data set numbers its frames on across scenes: the first frame of the second
 // scene must not see the last frame of the first as its predecessor. Evaluation and timing reset
 // the upscaler's history there instead.
 TEST(Evaluation, HistoryIsResetAtEverySceneCut) {
-  const auto dir = scratch_dir("eval-scene-cut");
-  std::string second = slurp(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
-  second.replace(second.find("name: tiny\n"), 11, "name: tiny_b\n");
-  std::ofstream(dir / "tiny_b.yaml") << second;
-  const auto render = run_cgsr("render --scene " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --scene " +
-                               (dir / "tiny_b.yaml").string() + " --out " + (dir / "set").string() + " --threads 1");
-  ASSERT_EQ(render.exit_code, 0) << render.err;
-  const Dataset data = Dataset::open(dir / "set");
+  const Dataset data = Dataset::open(two_scene_set());
   ASSERT_EQ(data.scenes().size(), 2u);
   const int cut = data.frames(Split::All).size() / 2;  // both scenes have 6 frames
   ASSERT_FALSE(data.has_previous(cut));
@@ -325,6 +339,60 @@ TEST(Evaluation, HistoryIsResetAtEverySceneCut) {
   const TimingSequence timing = timing_sequence(data, {cut}, 2, recording, 1);
   timing.run(recording, 0);
   EXPECT_EQ(recording.seen, (std::vector<int>{reset, cut}));
+}
+
+// `cgsr eval` on two scenes draws PSNR per frame beside results.json: one line per model and
+// scene, a dashed line at the cut (and one in the legend), no model's line crossing it, and the
+// page shows it.
+TEST(Evaluation, EvalCommandPlotsPsnrPerFrameWithTheSceneCut) {
+  const auto dir = scratch_dir("eval-frame-plot");
+  const auto r = run_cgsr("eval --data '" + two_scene_set().string() +
+                          "' --model bicubic --model nearest --split all --latency-runs 0 --out '" +
+                          (dir / "run").string() + "' --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = read_json(dir / "run" / "results.json");
+  const auto& starts = j.at("evaluations").at(0).at("scene_starts");
+  ASSERT_EQ(starts.size(), 2u) << starts.dump();
+  EXPECT_EQ(starts[1].at("scene"), "tiny_b");
+  const int cut = starts[1].at("first_frame");
+  EXPECT_EQ(cut, 6);
+  ASSERT_EQ(j.at("tables").size(), 1u);
+  const std::string file = j["tables"][0].at("frame_plot_svg");
+  ASSERT_FALSE(file.empty());
+  EXPECT_NE(slurp(dir / "run" / "index.html").find("<img src=\"" + file + "\""), std::string::npos);
+
+  const auto table = group_results(collect_evaluations({(dir / "run").string()})).at(0);
+  const auto plot = psnr_per_frame_plot(table);
+  ASSERT_TRUE(plot.has_value());
+  ASSERT_EQ(plot->series.size(), 2u);
+  const auto paths = svg_paths(slurp(dir / "run" / file));
+  // The cut: a dashed vertical line across the plot, and the legend's sample of it.
+  std::vector<double> cut_x;
+  int dashed = 0;
+  for (const auto& p : paths)
+    if (p.stroked && p.dashed) {
+      ++dashed;
+      if (p.xs.size() == 2 && p.xs[0] == p.xs[1]) cut_x.push_back(p.xs[0]);
+    }
+  EXPECT_EQ(dashed, 2);
+  ASSERT_EQ(cut_x.size(), 1u);
+  // The frame round the plot area (its legend samples are right of it).
+  double right = 0;
+  for (const auto& p : paths)
+    if (p.stroked && p.straight && p.stroke == Rgb{60, 60, 60}) right = *std::max_element(p.xs.begin(), p.xs.end());
+  ASSERT_GT(right, cut_x[0]);
+  for (const auto& s : plot->series) {
+    int lines = 0;
+    for (const auto& p : paths) {
+      if (!p.stroked || !p.straight || p.dashed || p.stroke != s.colour) continue;
+      if (*std::max_element(p.xs.begin(), p.xs.end()) >= right) continue;  // the legend's sample
+      ++lines;
+      const bool before = p.xs.front() < cut_x[0];
+      for (double x : p.xs) EXPECT_EQ(x < cut_x[0], before) << s.name << ": a line crosses the cut";
+    }
+    EXPECT_EQ(lines, 2) << s.name << ": one line per scene of 6 frames";
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // Every evaluation names the ground truth it measured against: the tiny scene rendered aliased

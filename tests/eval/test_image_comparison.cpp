@@ -97,7 +97,7 @@ TEST(ImageComparison, EvalSaveImagesWritesPicturesAndAPageWhoseLinksResolve) {
 
   const auto page = dir / "a" / "index.html";
   ASSERT_TRUE(fs::exists(page));
-  EXPECT_EQ(page_links(page).size(), 4u);  // two crop grids and two error maps
+  EXPECT_EQ(page_links(page).size(), 5u);  // two crop grids, two error maps and PSNR per frame
   EXPECT_TRUE(missing_links(page).empty()) << missing_links(page).front();
 }
 

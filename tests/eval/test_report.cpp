@@ -1,10 +1,17 @@
-// The report: Pareto front, tables, CSV and plot from evaluation results.
+// The report: Pareto front, tables, CSV and plot from evaluation results, and PSNR per frame
+// (lines broken at scene cuts and missing frames, infinite PSNR drawn on the edge).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/run_dir.h"
+#include "eval/frame_plot.h"
 #include "eval/report.h"
+#include "tests/support/svg_paths.h"
 
 using namespace cgsr;
 
@@ -134,4 +141,165 @@ TEST(Report, PlotMarksRolesAndJoinsPairs) {
   ASSERT_EQ(plot.links.size(), 1u);  // a pair with a missing row is left out
   EXPECT_DOUBLE_EQ(plot.links[0].x0, 12.5);
   EXPECT_DOUBLE_EQ(plot.links[0].x1, 12.1);
+}
+
+namespace {
+// A row scored on `frames`, PSNR 30 + frame / 100 (+inf on `identical`), in scenes starting at
+// the given (name, first frame).
+EvalResult scored(const std::string& name, const std::vector<int>& frames, std::vector<SceneStart> scenes,
+                  const std::vector<int>& identical = {}) {
+  EvalResult r = row(name, 30, 1.0);
+  r.frames.clear();
+  for (int f : frames) {
+    FrameScore s;
+    s.frame = f;
+    s.psnr = std::find(identical.begin(), identical.end(), f) != identical.end() ? INFINITY : 30 + f / 100.0;
+    r.frames.push_back(s);
+  }
+  r.scene_starts = std::move(scenes);
+  return r;
+}
+
+std::vector<std::vector<double>> segment_xs(const LineSeries& s) {
+  std::vector<std::vector<double>> out;
+  for (const auto& segment : s.segments) {
+    out.emplace_back();
+    for (const auto& p : segment) out.back().push_back(p.x);
+  }
+  return out;
+}
+}  // namespace
+
+// Consecutive frames: a line per scene, broken where frames 8 and 9 were not evaluated.
+TEST(Report, PsnrPerFrameBreaksAtSceneCutsAndMissingFrames) {
+  const std::vector<SceneStart> scenes = {{"hall", 0}, {"yard", 6}};
+  ReportTable t{"set", 2, {scored("bicubic", {0, 1, 2, 3, 4, 5, 6, 7, 10, 11}, scenes),
+                           scored("pan", {0, 1, 2, 3, 4, 5, 6, 7, 10, 11}, scenes)}, ""};
+  const auto plot = psnr_per_frame_plot(t);
+  ASSERT_TRUE(plot.has_value());
+  ASSERT_EQ(plot->series.size(), 2u);
+  for (const auto& s : plot->series)
+    EXPECT_EQ(segment_xs(s), (std::vector<std::vector<double>>{{0, 1, 2, 3, 4, 5}, {6, 7}, {10, 11}})) << s.name;
+  EXPECT_NE(plot->series[0].colour, plot->series[1].colour);
+  ASSERT_EQ(plot->regions.size(), 2u);
+  EXPECT_EQ(plot->regions[1].start, 6);
+  EXPECT_EQ(plot->regions[1].name, "yard");
+  EXPECT_FALSE(plot->boundary_name.empty());
+}
+
+// A test split samples every 10th frame or so: those are joined within a scene, with a dot on
+// each, and the cut is drawn where the second scene begins, before its first sample.
+TEST(Report, PsnrPerFrameJoinsTheSamplesOfASplitWithinAScene) {
+  ReportTable t{"set", 2, {scored("bicubic", {4, 14, 25, 35, 46, 56, 86}, {{"hall", 0}, {"yard", 40}})}, ""};
+  const auto plot = psnr_per_frame_plot(t);
+  ASSERT_TRUE(plot.has_value());
+  // 86 is 30 frames after 56: more than twice the usual step of 10, a stretch nobody measured.
+  EXPECT_EQ(segment_xs(plot->series[0]), (std::vector<std::vector<double>>{{4, 14, 25, 35}, {46, 56}, {86}}));
+  EXPECT_TRUE(plot->series[0].dots);
+  EXPECT_EQ(plot->regions[1].start, 40);
+}
+
+TEST(Report, NoPsnrPerFrameForASingleFrame) {
+  ReportTable one{"set", 2, {scored("bicubic", {3}, {{"hall", 0}}), scored("pan", {3}, {{"hall", 0}})}, ""};
+  EXPECT_FALSE(psnr_per_frame_plot(one).has_value());
+  // Results from before scene starts were recorded: one scene, no cut.
+  ReportTable old{"set", 2, {scored("bicubic", {3, 4}, {})}, ""};
+  const auto plot = psnr_per_frame_plot(old);
+  ASSERT_TRUE(plot.has_value());
+  EXPECT_TRUE(plot->regions.empty());
+  EXPECT_TRUE(plot->boundary_name.empty());
+  EXPECT_EQ(plot->series[0].segments.size(), 1u);
+}
+
+// Frames whose output equals the ground truth have PSNR +inf: drawn on the top edge and said so,
+// with every coordinate of the SVG finite, also when every frame of a model is identical.
+TEST(Report, InfinitePsnrPerFrameStaysOnThePlot) {
+  const std::vector<SceneStart> scenes = {{"hall", 0}};
+  ReportTable t{"set", 2,
+                {scored("nearest", {0, 1, 2, 3}, scenes, {2}), scored("copy", {0, 1, 2, 3}, scenes, {0, 1, 2, 3})}, ""};
+  const auto plot = psnr_per_frame_plot(t);
+  ASSERT_TRUE(plot.has_value());
+  EXPECT_TRUE(std::any_of(plot->notes.begin(), plot->notes.end(),
+                          [](const std::string& n) { return n.find("+inf") != std::string::npos; }));
+  const auto canvas = draw_line_plot(*plot);
+  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-frame-plot";
+  canvas->save(dir / "frames.svg");
+  const auto paths = test::svg_paths(read_file(dir / "frames.svg"));
+  ASSERT_FALSE(paths.empty());
+  size_t numbers = 0;
+  for (const auto& p : paths)
+    for (const auto& n : p.numbers) {
+      ++numbers;
+      EXPECT_TRUE(std::isfinite(std::stod(n))) << n;
+    }
+  EXPECT_GT(numbers, 100u);
+  // nearest's line runs through its infinite frame, on the top edge of the plot area: the frame
+  // drawn round it (Cairo would turn an infinite coordinate into some finite one, so the test
+  // checks where the point is).
+  const auto stroked = [&](const Rgb& colour) {
+    std::vector<test::SvgPath> out;
+    for (const auto& p : paths)
+      if (p.stroked && p.straight && !p.dashed && p.stroke == colour) out.push_back(p);
+    return out;
+  };
+  const auto frame = stroked({60, 60, 60});
+  ASSERT_EQ(frame.size(), 1u);
+  const double top = *std::min_element(frame[0].ys.begin(), frame[0].ys.end());
+  const double right = *std::max_element(frame[0].xs.begin(), frame[0].xs.end());
+  // A model's lines inside the frame (its legend sample is right of it).
+  const auto lines = [&](const Rgb& colour) {
+    std::vector<test::SvgPath> out;
+    for (const auto& p : stroked(colour))
+      if (*std::max_element(p.xs.begin(), p.xs.end()) < right) out.push_back(p);
+    return out;
+  };
+  const auto nearest = lines(plot->series[0].colour);
+  ASSERT_EQ(nearest.size(), 1u);
+  ASSERT_EQ(nearest[0].ys.size(), 4u);
+  EXPECT_NEAR(nearest[0].ys[2], top, 0.01);
+  EXPECT_GT(std::min({nearest[0].ys[0], nearest[0].ys[1], nearest[0].ys[3]}), top + 10);
+  const auto copy = lines(plot->series[1].colour);  // along the edge (Cairo merges its collinear points)
+  ASSERT_EQ(copy.size(), 1u);
+  for (double y : copy[0].ys) EXPECT_NEAR(y, top, 0.01);
+  std::filesystem::remove_all(dir);
+}
+
+// The report draws PSNR per frame under each table with two evaluated frames, records it in its
+// results and shows it on its page.
+TEST(Report, WriteReportDrawsPsnrPerFrame) {
+  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-frames";
+  std::filesystem::remove_all(dir);
+  auto single = scored("bicubic", {3}, {{"yard", 0}});
+  single.dataset = "yard";
+  {
+    RunDir run(dir, /*own_log=*/false);
+    const auto results =
+        write_report({scored("bicubic", {0, 1, 2}, {{"hall", 0}}), scored("pan", {0, 1, 2}, {{"hall", 0}}), single}, run);
+    ASSERT_EQ(results.at("tables").size(), 2u);
+    EXPECT_EQ(results["tables"][0].at("frame_plot_svg"), "psnr_per_frame_hall_x2.svg");
+    EXPECT_EQ(results["tables"][0].at("frame_plot"), "psnr_per_frame_hall_x2.png");
+    EXPECT_EQ(results["tables"][1].at("frame_plot_svg"), "");  // one frame: nothing to draw
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "psnr_per_frame_hall_x2.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "psnr_per_frame_hall_x2.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "psnr_per_frame_yard_x2.svg"));
+  const std::string page = read_file(dir / "index.html"), md = read_file(dir / "report.md");
+  EXPECT_NE(page.find("<img src=\"psnr_per_frame_hall_x2.svg\""), std::string::npos) << page;
+  EXPECT_EQ(page.find("psnr_per_frame_yard"), std::string::npos);
+  EXPECT_NE(md.find("(psnr_per_frame_hall_x2.png)"), std::string::npos) << md;
+  std::filesystem::remove_all(dir);
+}
+
+// Scene starts go through results.json and back (the report redraws the cuts from it).
+TEST(Report, SceneStartsSurviveJson) {
+  const auto r = scored("bicubic", {0, 7}, {{"hall", 0}, {"yard", 6}});
+  const auto back = eval_result_from_json(to_json(r), "test");
+  ASSERT_EQ(back.scene_starts.size(), 2u);
+  EXPECT_EQ(back.scene_starts[1].scene, "yard");
+  EXPECT_EQ(back.scene_starts[1].first_frame, 6);
+  auto old = to_json(r);
+  old.erase("scene_starts");
+  EXPECT_TRUE(eval_result_from_json(old, "test").scene_starts.empty());
+  old["scene_starts"] = {{{"scene", "hall"}}};
+  EXPECT_THROW(eval_result_from_json(old, "results.json: evaluations[0]"), Error);
 }
