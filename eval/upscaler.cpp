@@ -56,6 +56,7 @@ class JitteredBicubicUpscaler : public Upscaler {
   explicit JitteredBicubicUpscaler(int scale) : scale_(scale) {}
   std::string name() const override { return "bicubic_at_jitter"; }
   int scale() const override { return scale_; }
+  bool reads_jitter() const override { return true; }
   torch::Tensor upscale(const Batch& batch) override {
     torch::NoGradGuard no_grad;
     return batch.lr_jitter.empty() ? upscale_bicubic(batch.lr_color, scale_)
@@ -73,6 +74,7 @@ class HistoryFillUpscaler : public Upscaler {
   std::string name() const override { return "history"; }
   int scale() const override { return scale_; }
   std::vector<RenderChannel> channels() const override { return {RenderChannel::History}; }
+  bool reads_jitter() const override { return true; }
   torch::Tensor upscale(const Batch& batch) override {
     torch::NoGradGuard no_grad;
     if (!batch.hr_info.defined() || batch.hr_info.numel() == 0)

@@ -59,9 +59,12 @@ class Upscaler {
   // Reads the batches' sub-pixel BSP border images (Batch::lr_bsp_border): runs only on data
   // sets rendered with them (DatasetInfo::bsp_border).
   virtual bool reads_bsp_border() const { return false; }
+  // Reads each frame's jitter (Batch::lr_jitter): meant for jittered data sets.
+  virtual bool reads_jitter() const { return false; }
 };
 
-// nearest, bilinear, bicubic, lanczos, fsr, bsp_border (only on data sets with BSP border files)
+// nearest, bilinear, bicubic, lanczos, fsr, bsp_border (only on data sets with BSP border files),
+// and for jittered frames bicubic_at_jitter and history (eval/baselines/history_fill.h)
 using ClassicFactory = std::function<std::unique_ptr<Upscaler>(int scale)>;
 const Registry<ClassicFactory>& classic_upscalers();
 

@@ -21,7 +21,8 @@ config::Schema<EvalCommandOptions> eval_schema() {
   s.field("scene", &EvalCommandOptions::scene, "evaluate one scene of a multi-scene data set (default: all)");
   s.omit_when("scene", [](const EvalCommandOptions& o) { return o.scene.empty(); });  // `cgsr run`'s eval hash as before
   s.field("models", &EvalCommandOptions::models,
-          "model files and classic upscalers (" + join(classic_upscalers().names()) + ", or 'classic' for all)")
+          "model files and classic upscalers (" + join(classic_upscalers().names()) +
+              ", or 'classic' for all that read the colour alone)")
       .check([](const auto& v) { return !v.empty(); }, "needs at least one model or upscaler");
   s.field("names", &EvalCommandOptions::names, "display names, in the order of models");
   s.field("scale", &EvalCommandOptions::scale, "scale of the classic upscalers").range(2, 4);
@@ -120,6 +121,9 @@ nlohmann::ordered_json run_eval(const EvalCommandOptions& options, RunDir* run_d
     const std::string name = options.names.empty() ? "" : options.names[i];
     if (options.models[i] == "classic") {
       for (const auto& c : classic_upscalers().names()) {
+        // The single-frame filters: the temporal ones (history, bicubic_at_jitter) are named on
+        // their own, for jittered data sets with motion.
+        if (classic_upscalers().get(c)(options.scale)->reads_jitter()) continue;
         entries.emplace_back(c, "");
         from_classic.push_back(true);
       }
