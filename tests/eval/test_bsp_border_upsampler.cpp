@@ -140,7 +140,8 @@ TEST(BspBorderUpsampler, BeatsBicubicOnGeometryEdgesOfRenderedFrames) {
 }
 
 // `cgsr eval`: 'classic' includes bsp_border on a data set with BSP border files and leaves it out
-// elsewhere, where naming it is a user error saying how to render them.
+// elsewhere, where naming it is a user error saying how to render them; it never lists the
+// upscalers that read the jitter.
 TEST(BspBorderUpsampler, EvalListsItOnlyWhereTheDataHasTheFiles) {
   const auto dir = test::scratch_dir("bsp-border-eval");
   const auto render = test::run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) +
@@ -162,6 +163,9 @@ TEST(BspBorderUpsampler, EvalListsItOnlyWhereTheDataHasTheFiles) {
   const auto plain = names(test::read_json(dir / "without" / "results.json"));
   EXPECT_EQ(std::find(plain.begin(), plain.end(), "bsp_border"), plain.end());
   EXPECT_EQ(plain.size() + 1, listed.size());
+  // Nor does it list the upscalers that read the jitter (they are named on their own).
+  for (const char* temporal : {"bicubic_at_jitter", "history"})
+    EXPECT_EQ(std::find(listed.begin(), listed.end(), temporal), listed.end()) << temporal;
   const auto named = test::run_cgsr("eval --data " + test::tiny_data().string() +
                                     " --model bsp_border --latency-runs 0 --threads 1 --out " + (dir / "named").string());
   EXPECT_EQ(named.exit_code, 2);
