@@ -6,9 +6,11 @@
 
 namespace cgsr {
 namespace {
-// One colour per model, in the order of the table's rows (repeating after the last).
-const std::vector<Rgb> kColours = {{40, 90, 180},  {210, 40, 40},  {40, 150, 60},  {200, 130, 20}, {130, 60, 170},
-                                   {110, 110, 110}, {20, 160, 170}, {180, 60, 130}, {110, 80, 30}};
+// One colour per model, in the order of the table's rows (repeating after the last): enough for
+// the quickstart's report, whose tables have 12 rows.
+const std::vector<Rgb> kColours = {{40, 90, 180},  {210, 40, 40},  {40, 150, 60},   {200, 130, 20},
+                                   {130, 60, 170}, {110, 110, 110}, {20, 160, 170},  {180, 60, 130},
+                                   {110, 80, 30},  {0, 0, 0},       {120, 190, 240}, {150, 200, 60}};
 
 // The index into `starts` of the scene holding `frame`: the last one starting at or before it
 // (0 when none does, or when there are no starts: one scene).
