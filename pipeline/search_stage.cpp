@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <limits>
 
+#include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/plot.h"
 #include "core/yaml_json.h"
 #include "models/complexity.h"
 #include "models/elastic.h"
+#include "models/latency_table.h"
 #include "models/model_file.h"
 #include "models/subnet.h"
 #include "render_data/dataset.h"
@@ -23,6 +26,9 @@ config::Schema<PickOptions> pick_schema() {
           "latency budget of the pick, as a fraction of the full network's predicted latency").range(0.001, 1);
   s.field("latency_ms", &PickOptions::latency_ms, "latency budget in ms (when > 0; replaces latency_fraction)")
       .at_least(0);
+  s.field("measure_runs", &PickOptions::measure_runs,
+          "timed runs per subnet when the pick is checked by measured latency (0: the table's prediction decides)")
+      .range(0, 100);
   return s;
 }
 
@@ -37,6 +43,52 @@ config::Schema<FinalTraining> final_schema() {
 nlohmann::ordered_json candidate_json(const Candidate& c) {
   return {{"key", c.key}, {"generation", c.generation}, {"quality", c.quality}, {"score", c.score},
           {"subnet", to_json(c.subnet)}};
+}
+
+// The pick as measured against the full network, kept in pick.json: timings differ between
+// runs, so a search resumed after its pick fine-tunes the subnet it measured, not another.
+struct MeasuredChoice {
+  MeasuredPick measured;
+  double full_ms = 0;
+};
+
+nlohmann::ordered_json to_json(const MeasuredChoice& c) {
+  nlohmann::ordered_json j = {{"key", c.measured.pick.key}, {"ms", c.measured.measured_ms}, {"full_ms", c.full_ms},
+                              {"fits", c.measured.fits}, {"timed", nlohmann::ordered_json::array()}};
+  for (const auto& [key, ms] : c.measured.timed) j["timed"].push_back({{"key", key}, {"ms", ms}});
+  return j;
+}
+
+MeasuredChoice measured_choice(const SRNetworkImpl& net, const Candidate& full, const std::vector<Candidate>& front,
+                               double predicted_budget, const LatencyTable& table,
+                               const SearchCommandOptions& options, const std::filesystem::path& file) {
+  MeasuredChoice c;
+  if (options.resume && std::filesystem::exists(file)) {
+    const auto j = nlohmann::json::parse(read_file(file));
+    const auto key = j.at("key").get<std::string>();
+    const auto it = std::find_if(front.begin(), front.end(), [&](const Candidate& f) { return f.key == key; });
+    if (it == front.end()) throw Error(file.string(), "names subnet " + key + ", which is not on the search's front");
+    c.measured.pick = *it;
+    c.measured.measured_ms = j.at("ms").get<double>();
+    c.measured.fits = j.at("fits").get<bool>();
+    for (const auto& t : j.at("timed")) c.measured.timed.emplace_back(t.at("key").get<std::string>(), t.at("ms").get<double>());
+    c.full_ms = j.at("full_ms").get<double>();
+    spdlog::info("search: the pick measured before, from {}", file.string());
+    return c;
+  }
+  const auto time = [&](const SubnetConfig& sub) {
+    return measure_graph_latency(subnet_graph(net, sub), table.lr_width, table.lr_height, options.pick.measure_runs);
+  };
+  c.full_ms = time(full.subnet);
+  const double budget =
+      options.pick.latency_ms > 0 ? options.pick.latency_ms : options.pick.latency_fraction * c.full_ms;
+  c.measured = pick_measured(front, predicted_budget, budget, [&](const Candidate& f) { return time(f.subnet); });
+  spdlog::info("search: {} subnets timed on the fused path (the full network: {:.1f} ms); the best within {:.1f} ms "
+               "measures {:.1f} ms{}",
+               c.measured.timed.size(), c.full_ms, budget, c.measured.measured_ms,
+               c.measured.fits ? "" : " (none fits: the fastest)");
+  write_file_atomic(file, to_json(c).dump(2) + "\n");
+  return c;
 }
 
 struct SearchRun {
@@ -141,7 +193,12 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
 
   const double budget = options.pick.latency_ms > 0 ? options.pick.latency_ms
                                                     : options.pick.latency_fraction * full.score.latency_ms;
-  const Candidate pick = pick_within(runs.front().result.front, budget);
+  const std::vector<Candidate>& front = runs.front().result.front;
+  const MeasuredChoice choice = options.pick.measure_runs > 0
+                                    ? measured_choice(*elastic.network, full, front, budget, table, options,
+                                                      run_dir.file("pick.json"))
+                                    : MeasuredChoice{{pick_within(front, budget), 0, false, {}}, 0};
+  const Candidate& pick = choice.measured.pick;
   write_front_plot(run_dir.file("front.png"), runs, full, pick, budget);
   spdlog::info("search: pick {} at {:.1f} ms predicted ({:.0f}% of the full network's {:.1f} ms), {:.3f} dB "
                "(full: {:.3f} dB)", pick.key, pick.score.latency_ms, 100.0 * pick.score.latency_ms / latency_ref,
@@ -194,6 +251,7 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   }
   j["pick"] = candidate_json(pick);
   j["pick"]["budget_ms"] = budget;
+  if (options.pick.measure_runs > 0) j["pick"]["measured"] = to_json(choice);
   j["pick"]["spec"] = spec_summary(picked->spec());
   j["pick"]["params"] = inference_parameter_count(*picked);
   j["final_training"] = to_json(final_training);

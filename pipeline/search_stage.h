@@ -4,7 +4,8 @@
 // `elastic.enabled`). Evolution (NSGA-II) scores subnets by
 // inference on validation crops against the latency table stored with the network, and random
 // search with as many evaluations is its control; both fronts, their hypervolumes and a plot are
-// written. The pick, the best subnet within the latency budget, is materialized as a network of
+// written. The pick, the best subnet within the latency budget (predicted, then checked by
+// measurement on the fused path against the full network's), is materialized as a network of
 // its own and fine-tuned with distillation from the full network: model.cgsr.
 // history.jsonl (and random_history.jsonl) record every subnet and are the checkpoint of --resume.
 
@@ -22,6 +23,7 @@ namespace cgsr {
 struct PickOptions {
   double latency_fraction = 0.33;  // budget: this fraction of the full network's predicted latency
   double latency_ms = 0;           // or this many ms (when > 0)
+  int measure_runs = 5;            // timed runs per subnet when the pick is checked by measurement (0: not)
 };
 
 struct FinalTraining {

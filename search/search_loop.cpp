@@ -174,6 +174,28 @@ const Candidate& pick_within(const std::vector<Candidate>& front, double budget_
   return best ? *best : front.front();
 }
 
+MeasuredPick pick_measured(const std::vector<Candidate>& front, double predicted_budget_ms,
+                           double measured_budget_ms, const std::function<double(const Candidate&)>& measure,
+                           double predicted_slack) {
+  if (front.empty()) throw Error("search", "no subnet was scored");
+  int n = 1;
+  while (n < static_cast<int>(front.size()) && front[n].score.latency_ms <= predicted_slack * predicted_budget_ms) ++n;
+  MeasuredPick result;
+  std::vector<double> measured(n, 0);
+  int fits = -1, fails = n;  // front[..fits] measure within the budget, front[fails..] over it
+  while (fails - fits > 1) {
+    const int mid = (fits + fails) / 2;
+    measured[mid] = measure(front[mid]);
+    result.timed.emplace_back(front[mid].key, measured[mid]);
+    (measured[mid] <= measured_budget_ms ? fits : fails) = mid;
+  }
+  result.fits = fits >= 0;
+  const int chosen = std::max(fits, 0);
+  result.pick = front[chosen];
+  result.measured_ms = measured[chosen];
+  return result;
+}
+
 double front_hypervolume(const std::vector<Candidate>& front, double latency_ref, double quality_ref) {
   std::vector<double> cost, quality;
   for (const auto& c : front) {

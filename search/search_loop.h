@@ -12,6 +12,7 @@
 // worst (it gets the worst quality and never survives), retry (evaluated once more, then worst)
 // or abort (the search stops with the error).
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,21 @@ std::vector<Candidate> latency_front(const std::vector<Candidate>& candidates);
 
 // The best quality on `front` within `budget_ms` of predicted latency; the fastest when none fits.
 const Candidate& pick_within(const std::vector<Candidate>& front, double budget_ms);
+
+// The pick checked by measurement. A latency table errs by several percent on a subnet, enough to
+// carry the pick over its budget, so the front (fastest first, quality rising with latency) is
+// bisected by measured latency among the subnets predicted within `predicted_slack` of the
+// budget: the best that measures within `measured_budget_ms`, about log2(front) timings; the
+// fastest when none does.
+struct MeasuredPick {
+  Candidate pick;
+  double measured_ms = 0;
+  bool fits = false;
+  std::vector<std::pair<std::string, double>> timed;  // (key, measured ms), in the order timed
+};
+MeasuredPick pick_measured(const std::vector<Candidate>& front, double predicted_budget_ms,
+                           double measured_budget_ms, const std::function<double(const Candidate&)>& measure,
+                           double predicted_slack = 1.25);
 
 // The front's hypervolume against (latency_ref, quality_ref) (core/pareto.h).
 double front_hypervolume(const std::vector<Candidate>& front, double latency_ref, double quality_ref);

@@ -213,10 +213,12 @@ TEST(KillResume, SearchResumedTwiceMakesTheUninterruptedPick) {
 generations: 6
 baseline: ""
 crops: {frames: 2, crops_per_frame: 4, size: 24, margin: 4}
-pick: {latency_fraction: 0.6}
+pick: {latency_fraction: 0.6, measure_runs: 0}
 final:
   schedule: {steps: 60, batch_size: 2, patch_size: 16, validate_every: 20, val_frames: 1, checkpoint_every: 5, layout: nhwc}
 )";
+  // The pick is chosen by the latency table alone here: timings differ between two runs, so a
+  // measured pick need not match the uninterrupted run's (its resumption is checked at the end).
   const std::vector<std::string> search = {"search", "--config", config.string(), "--model", elastic.string(),
                                            "--data", data.string()};
   const auto reference = dir / "reference", out = dir / "run";
@@ -269,6 +271,24 @@ final:
   EXPECT_EQ(history_psnrs(got["final_training"]), history_psnrs(expected["final_training"]));
   EXPECT_NO_THROW(load_model(out / "model.cgsr"));
   expect_same_weights(reference / "model.cgsr", out / "model.cgsr");
+
+  // A pick checked by measurement is kept in pick.json: killed during its fine-tuning, the search
+  // resumes with the subnet it measured.
+  const auto measured = dir / "measured";
+  auto timed = search;
+  timed.insert(timed.end(), {"--set", "pick.measure_runs=2"});
+  ASSERT_NO_FATAL_FAILURE(kill_when(with_run_flags(timed, measured), dir / "killed3",
+                                    [&] { return fs::exists(measured / "final_checkpoint.pt"); }));
+  const auto before = read_json(measured / "pick.json");
+  EXPECT_GE(before["timed"].size(), 1u);
+  EXPECT_GT(before["full_ms"].get<double>(), 0);
+  r = run_cgsr_args(with_resume(with_run_flags(timed, measured)), dir / "resumed_measured");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(resumed_at(r.err), 0) << r.err;
+  const auto after = read_json(measured / "results.json");
+  EXPECT_EQ(after["pick"]["key"], before["key"]);
+  EXPECT_EQ(after["pick"]["measured"]["timed"], before["timed"]);
+  EXPECT_EQ(read_json(measured / "pick.json"), before);
   fs::remove_all(dir);
 }
 

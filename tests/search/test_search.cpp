@@ -3,6 +3,8 @@
 // each subnet from its real graph), and the inference evaluator on a rendered scene.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <random>
 #include <set>
@@ -171,6 +173,30 @@ TEST(SearchLoop, EvolutionScoresEverySubnetOnceAndBuildsAFront) {
   const double budget = r.front[r.front.size() / 2].score.latency_ms;
   EXPECT_EQ(pick_within(r.front, budget).key, r.front[r.front.size() / 2].key);
   EXPECT_EQ(pick_within(r.front, 0).key, r.front.front().key);
+
+  // Checked by measurement: a machine on which every subnet runs 20% slower than predicted. The
+  // pick is the best whose measured latency fits, found by bisection, not the predicted pick.
+  const double widest = r.front.back().score.latency_ms;
+  int timings = 0;
+  const auto slower = [&](const Candidate& c) {
+    ++timings;
+    return 1.2 * c.score.latency_ms;
+  };
+  const MeasuredPick m = pick_measured(r.front, widest, widest, slower);
+  int best_fitting = -1;
+  for (size_t i = 0; i < r.front.size(); ++i)
+    if (1.2 * r.front[i].score.latency_ms <= widest) best_fitting = static_cast<int>(i);
+  ASSERT_GT(best_fitting, 0);  // the front spans more than 20% of latency
+  EXPECT_TRUE(m.fits);
+  EXPECT_EQ(m.pick.key, r.front[best_fitting].key);
+  EXPECT_NE(m.pick.key, pick_within(r.front, widest).key);
+  EXPECT_DOUBLE_EQ(m.measured_ms, 1.2 * m.pick.score.latency_ms);
+  EXPECT_EQ(static_cast<int>(m.timed.size()), timings);
+  EXPECT_LE(timings, static_cast<int>(std::ceil(std::log2(r.front.size() + 1.0))));
+  // Nothing fits: the fastest subnet, flagged.
+  const MeasuredPick none = pick_measured(r.front, widest, 0, slower);
+  EXPECT_FALSE(none.fits);
+  EXPECT_EQ(none.pick.key, r.front.front().key);
 }
 
 TEST(SearchLoop, EvolutionFindsABetterFrontThanRandomSearchAtAsManyEvaluations) {
