@@ -163,18 +163,22 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", config::out_of_range(spec.rit.hr_width, 1, config::kUnbounded)});
-  if (spec.rit.bsp_composite) {
-    // The composite reads the bsp channel's colour and coverage at the output resolution.
+  // The composites read a channel's samples at the output resolution.
+  const auto check_composite = [&](bool on, const std::string& key, RenderChannel channel) {
+    if (!on) return;
+    const std::string name = channel_name(channel), what = "rit." + key;
     const std::vector<std::string> hr_sources(rit_sources().begin() + 1, rit_sources().end());  // lr is the first
     if (!spec.rit.enabled)
-      problems.push_back({"rit.bsp_composite", "composites the output with the RIT's bsp channel; enable rit"});
-    else if (std::find(rit_channels.begin(), rit_channels.end(), RenderChannel::Bsp) == rit_channels.end())
-      problems.push_back({"rit.bsp_composite", "composites the output with the bsp channel, which rit.channels [" +
-                                                   join(spec.rit.channels) + "] does not list: add bsp"});
+      problems.push_back({what, "composites the output with the RIT's " + name + " channel; enable rit"});
+    else if (std::find(rit_channels.begin(), rit_channels.end(), channel) == rit_channels.end())
+      problems.push_back({what, "composites the output with the " + name + " channel, which rit.channels [" +
+                                    join(spec.rit.channels) + "] does not list: add " + name});
     else if (!spec.rit.reads_hr())
-      problems.push_back({"rit.bsp_composite", "needs the bsp channel at the output resolution, which rit.source lr "
-                                               "does not give: use " + join(hr_sources, ", or ")});
-  }
+      problems.push_back({what, "needs the " + name + " channel at the output resolution, which rit.source lr "
+                                "does not give: use " + join(hr_sources, ", or ")});
+  };
+  check_composite(spec.rit.bsp_composite, "bsp_composite", RenderChannel::Bsp);
+  check_composite(spec.rit.history_blend, "history_blend", RenderChannel::History);
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -252,6 +256,9 @@ config::Schema<RitSpec> rit_spec_schema() {
             "output the bsp channel's image on the pixels its coverage marks, the network's elsewhere");
   // Written only when set, so specs and stage hashes from before the option read the same.
   rit.omit_when("bsp_composite", [](const RitSpec& r) { return !r.bsp_composite; });
+  rit.field("history_blend", &RitSpec::history_blend,
+            "blend the output with the history channel's samples by a learned weight where there is one");
+  rit.omit_when("history_blend", [](const RitSpec& r) { return !r.history_blend; });
   return rit;
 }
 
@@ -317,7 +324,7 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
-         " depth" + (r.bsp_composite ? ", bsp composite" : "") + "]";
+         " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

@@ -24,6 +24,8 @@
 //     depth_encoding: log    # log, linear or zbuffer (render_channels.h DepthEncoding)
 //     bsp_composite: false   # the output is the bsp channel's image where its coverage is 1,
 //                            #   the network's elsewhere (needs bsp among channels, an HR source)
+//     history_blend: false   # the output blended with the history channel's samples by a learned
+//                            #   weight (needs history among channels, an HR source)
 //   geometry:                # training-only head predicting the HR rendering information
 //     enabled: true
 //     width: 16
@@ -107,6 +109,10 @@ struct RitSpec {
   // bsp_rgb, m the channel's coverage. Where the renderer resolved the border (the BSP leaves) the
   // output is its image exactly; the network learns the rest.
   bool bsp_composite = false;
+  // The network's image blended with the history channel's reprojected samples at HR (rit.h):
+  // out = net + w * (history_rgb - net), w = sigmoid(conv(net, info)) * recency. Where no frame
+  // left a sample (recency 0) the output is the network's; elsewhere it learns how far to trust one.
+  bool history_blend = false;
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
@@ -120,7 +126,7 @@ struct RitSpec {
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
            hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding &&
-           bsp_composite == o.bsp_composite;
+           bsp_composite == o.bsp_composite && history_blend == o.history_blend;
   }
 };
 

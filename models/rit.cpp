@@ -22,6 +22,23 @@ torch::nn::Conv2d make_fusion(bool concat, int64_t feature_channels, int64_t wid
   return fuse;
 }
 
+// The first position of `channel` in an info tensor of `channels`.
+int64_t channel_offset(const std::vector<RenderChannel>& channels, RenderChannel channel) {
+  int64_t offset = 0;
+  for (auto c : channels) {
+    if (c == channel) return offset;
+    offset += channel_width(c);
+  }
+  throw Error("RIT", "needs the " + channel_name(channel) + " channel");
+}
+
+// [3, C, 1, 1]: output k picks input channel `first` + k (stride 1), or `first` for all three (stride 0).
+torch::Tensor selection(int64_t c, int64_t first, int64_t stride) {
+  auto s = torch::zeros({3, c, 1, 1});
+  for (int64_t k = 0; k < 3; ++k) s[k][first + stride * k] = 1.0f;
+  return s;
+}
+
 }  // namespace
 
 RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, FusionPoint hr_features)
@@ -49,20 +66,24 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
   }
   if (rit.bsp_composite) {
     CGSR_CHECK(info_factor_ == scale, "RIT: bsp_composite needs the information at the output resolution");
-    int64_t offset = 0;  // the bsp channel's first position in the info input
-    for (auto channel : rit.render_channels()) {
-      if (channel == RenderChannel::Bsp) break;
-      offset += channel_width(channel);
-    }
-    CGSR_CHECK(offset < c, "RIT: bsp_composite needs the bsp channel");
-    bsp_color_ = torch::zeros({3, c, 1, 1});
-    bsp_coverage_ = torch::zeros({3, c, 1, 1});
-    for (int64_t k = 0; k < 3; ++k) {
-      bsp_color_[k][offset + k] = 1.0f;
-      bsp_coverage_[k][offset + 3] = 1.0f;
-    }
+    const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::Bsp);
+    bsp_color_ = selection(c, offset, 1);
+    bsp_coverage_ = selection(c, offset + 3, 0);
     complement_scale_ = torch::full({3}, -1.0f);
     complement_shift_ = torch::full({3}, 1.0f);
+  }
+  if (rit.history_blend) {
+    CGSR_CHECK(info_factor_ == scale, "RIT: history_blend needs the information at the output resolution");
+    const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::History);
+    history_color_ = selection(c, offset, 1);
+    history_recency_ = selection(c, offset + 3, 0);
+    negate_scale_ = torch::full({3}, -1.0f);
+    negate_shift_ = torch::zeros({3});
+    ParameterBudget::charge_conv(3 + c, 3, 3, 1, /*bias=*/true);
+    blend = register_module("blend", make_conv(3 + c, 3, 3));
+    zero_conv(blend);
+    torch::NoGradGuard no_grad;
+    blend->bias.fill_(-4.0f);
   }
 }
 
@@ -124,6 +145,23 @@ int RitBlockImpl::describe_composite_bsp(graph::Builder& g, int image, int info)
   const int kept = g.affine("bsp_complement", covered, complement_scale_, complement_shift_, /*trainable=*/false);
   const int bsp = g.conv("bsp_color", info, bsp_color_, {}, 0, rgb, /*trainable=*/false);
   return g.add(g.mul(kept, image), g.mul(covered, bsp));
+}
+
+torch::Tensor RitBlockImpl::blend_history(const torch::Tensor& image, const torch::Tensor& info) {
+  // The kernels and the operand order of describe_blend_history(), so both give the same bits.
+  const auto weight = torch::sigmoid(blend(torch::cat({image, info}, 1))) * torch::conv2d(info, history_recency_);
+  const auto difference = torch::conv2d(info, history_color_) + graph::apply_affine(image, negate_scale_, negate_shift_);
+  return image + weight * difference;
+}
+
+int RitBlockImpl::describe_blend_history(graph::Builder& g, int image, int info) const {
+  const auto rgb = g.value(image).layout;
+  const int logit = describe_conv(g, "blend", blend, g.concat({image, info}), rgb);
+  const int recency = g.conv("history_recency", info, history_recency_, {}, 0, rgb, /*trainable=*/false);
+  const int weight = g.mul(g.sigmoid(logit), recency);
+  const int history = g.conv("history_color", info, history_color_, {}, 0, rgb, /*trainable=*/false);
+  const int negated = g.affine("history_negate", image, negate_scale_, negate_shift_, /*trainable=*/false);
+  return g.add(image, g.mul(weight, g.add(history, negated)));
 }
 
 }  // namespace cgsr

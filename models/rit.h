@@ -32,6 +32,14 @@
 // with fixed 0/1 1x1 convs that pick the colour and the coverage (broadcast to 3 channels) out of
 // the info input, a ChannelAffine for 1 - m, Mul and Add: every runtime runs it, and as m is 0 or
 // 1 the result is exactly bsp_rgb or net (0 * x + y == y), not net + (bsp - net) rounded.
+//
+// rit.history_blend: the image blended with the history channel's samples (render_data/
+// history_channel.h), read from the raw HR input: out = net + w * (hist_rgb - net), with
+// w = sigmoid(conv3x3(cat(net, info))) * recency. Recency is 0 where no frame left a sample, so the
+// output there is the network's exactly; elsewhere the conv (layer "blend", 3 outputs, starting at
+// weight 0 and bias -4: w under 0.02) learns how far to trust a sample from its age, the
+// G-buffers and its disagreement with the network. A network given the samples as input learned
+// nothing from them (docs/results/history.md); here using one is a single weight away.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/conv.h>
@@ -69,6 +77,10 @@ class RitBlockImpl : public torch::nn::Module {
   bool composites_bsp() const { return bsp_color_.defined(); }
   torch::Tensor composite_bsp(const torch::Tensor& image, const torch::Tensor& info) const;
   int describe_composite_bsp(graph::Builder& g, int image, int info) const;
+  // rit.history_blend: the image blended with the history channel of `info` (the raw HR input).
+  bool blends_history() const { return !blend.is_empty(); }
+  torch::Tensor blend_history(const torch::Tensor& image, const torch::Tensor& info);
+  int describe_blend_history(graph::Builder& g, int image, int info) const;
 
   bool has_feature_branch() const { return !conv.is_empty(); }
   bool has_hr_branch() const { return !hr_conv.is_empty(); }
@@ -80,6 +92,7 @@ class RitBlockImpl : public torch::nn::Module {
   torch::Tensor gate;  // [C], R_i of the paper, initialized to 1
   torch::nn::Conv2d conv{nullptr}, fuse{nullptr};        // the feature part
   torch::nn::Conv2d hr_conv{nullptr}, hr_fuse{nullptr};  // the HR part
+  torch::nn::Conv2d blend{nullptr};                      // history_blend: the weight's conv
 
  private:
   // features + fusion(cat(features, x)) or features + fusion(x), and its graph mirror.
@@ -95,6 +108,9 @@ class RitBlockImpl : public torch::nn::Module {
   // bsp_composite: constants (no parameters, not in model files), [3, C, 1, 1] 0/1 selections of
   // the bsp colour and of its coverage for each of R, G, B; and 1 - m as scale -1, shift 1.
   torch::Tensor bsp_color_, bsp_coverage_, complement_scale_, complement_shift_;
+  // history_blend: constants, [3, C, 1, 1] selections of the history colour and of its recency
+  // (broadcast to R, G, B); and -x as scale -1, shift 0.
+  torch::Tensor history_color_, history_recency_, negate_scale_, negate_shift_;
 };
 TORCH_MODULE(RitBlock);
 

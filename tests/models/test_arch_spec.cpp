@@ -161,36 +161,47 @@ TEST(ArchSpec, ProgrammaticSpecsAreValidatedToo) {
   EXPECT_THROW(resolve_spec(s), Error);
 }
 
-// rit.bsp_composite reads the bsp channel's colour and coverage at HR: without the channel, with
-// rit.source lr or without a RIT it is an error naming the key; it is written only when set.
-TEST(ArchSpec, BspCompositeNeedsTheBspChannelAtHr) {
-  const std::string missing =
-      parse_error("backbone: pan\nrit: {enabled: true, channels: [depth, edge], source: hr_fuse, bsp_composite: true}\n");
-  EXPECT_NE(missing.find("rit.bsp_composite"), std::string::npos) << missing;
-  EXPECT_NE(missing.find("does not list: add bsp"), std::string::npos) << missing;
-  const std::string lr = parse_error("backbone: pan\nrit: {enabled: true, channels: [bsp], bsp_composite: true}\n");
-  EXPECT_NE(lr.find("rit.bsp_composite"), std::string::npos) << lr;
-  EXPECT_NE(lr.find("rit.source lr"), std::string::npos) << lr;
-  EXPECT_NE(lr.find("hr_unshuffle+hr_fuse"), std::string::npos) << lr;
-  const std::string off = parse_error("backbone: pan\nrit: {channels: [bsp], source: hr_fuse, bsp_composite: true}\n");
-  EXPECT_NE(off.find("rit.bsp_composite"), std::string::npos) << off;
-  EXPECT_NE(off.find("enable rit"), std::string::npos) << off;
+// rit.bsp_composite and rit.history_blend read their channel at HR: without the channel, with
+// rit.source lr or without a RIT it is an error naming the key; each is written only when set.
+TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
+  struct Composite {
+    std::string key, channel, summary;
+    bool RitSpec::*flag;
+  };
+  for (const Composite& c : {Composite{"bsp_composite", "bsp", "bsp composite", &RitSpec::bsp_composite},
+                             Composite{"history_blend", "history", "history blend", &RitSpec::history_blend}}) {
+    SCOPED_TRACE(c.key);
+    const std::string key = "rit." + c.key;
+    const std::string missing = parse_error("backbone: pan\nrit: {enabled: true, channels: [depth, edge], source: hr_fuse, " +
+                                            c.key + ": true}\n");
+    EXPECT_NE(missing.find(key), std::string::npos) << missing;
+    EXPECT_NE(missing.find("does not list: add " + c.channel), std::string::npos) << missing;
+    const std::string lr =
+        parse_error("backbone: pan\nrit: {enabled: true, channels: [" + c.channel + "], " + c.key + ": true}\n");
+    EXPECT_NE(lr.find(key), std::string::npos) << lr;
+    EXPECT_NE(lr.find("rit.source lr"), std::string::npos) << lr;
+    EXPECT_NE(lr.find("hr_unshuffle+hr_fuse"), std::string::npos) << lr;
+    const std::string off =
+        parse_error("backbone: pan\nrit: {channels: [" + c.channel + "], source: hr_fuse, " + c.key + ": true}\n");
+    EXPECT_NE(off.find(key), std::string::npos) << off;
+    EXPECT_NE(off.find("enable rit"), std::string::npos) << off;
 
-  ArchSpec s = default_spec("pan", 2);
-  s.rit.enabled = true;
-  s.rit.channels = {"bsp"};
-  s.rit.source = RitSource::HrFuse;
-  EXPECT_EQ(spec_to_yaml(s).find("bsp_composite"), std::string::npos);
-  s.rit.bsp_composite = true;
-  const std::string yaml = spec_to_yaml(s);
-  EXPECT_NE(yaml.find("bsp_composite: true"), std::string::npos) << yaml;
-  EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
-  EXPECT_NE(spec_summary(s).find("bsp composite"), std::string::npos) << spec_summary(s);
-  s.rit.source = RitSource::Lr;
-  try {
-    validate_spec(s);
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.context(), "arch spec: rit.bsp_composite");
+    ArchSpec s = default_spec("pan", 2);
+    s.rit.enabled = true;
+    s.rit.channels = {c.channel};
+    s.rit.source = RitSource::HrFuse;
+    EXPECT_EQ(spec_to_yaml(s).find(c.key), std::string::npos);
+    s.rit.*c.flag = true;
+    const std::string yaml = spec_to_yaml(s);
+    EXPECT_NE(yaml.find(c.key + ": true"), std::string::npos) << yaml;
+    EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
+    EXPECT_NE(spec_summary(s).find(c.summary), std::string::npos) << spec_summary(s);
+    s.rit.source = RitSource::Lr;
+    try {
+      validate_spec(s);
+      FAIL();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.context(), "arch spec: " + key);
+    }
   }
 }

@@ -277,3 +277,69 @@ TEST(Rit, BspCompositeIsTheBspImageWhereCoveredAndTheNetworkElsewhere) {
       EXPECT_EQ(inference_parameter_count(*net), inference_parameter_count(*plain));
     }
 }
+
+// rit.history_blend over every backbone, scale and HR source: where the history channel has no
+// sample (recency 0) the output is the same network's without the option, bit for bit; where it
+// has one, a blend weight driven high gives the sample; the graph computes what forward() does;
+// the blend's conv (3 outputs over the image and the info) is its only parameter.
+TEST(Rit, HistoryBlendIsTheNetworkWithoutASampleAndLearnsToTakeOne) {
+  torch::manual_seed(29);
+  for (const auto& c : all_backbone_cases())
+    for (const auto& source : rit_sources_for(c.backbone)) {
+      if (source == "lr") continue;
+      SCOPED_TRACE(case_name(c) + " " + source);
+      ArchSpec plain_spec = with_rit(spec_for(c), source);
+      plain_spec.rit.channels = {"edge", "history"};  // history at positions 1..4: the offset counts
+      plain_spec = resolve_spec(plain_spec);
+      ArchSpec spec = plain_spec;
+      spec.rit.history_blend = true;
+      SRNetwork plain(plain_spec), net(resolve_spec(spec));
+      randomize_fusion(*plain, 0.1);
+      {
+        torch::NoGradGuard no_grad;
+        auto theirs = plain->named_parameters();
+        for (auto& p : net->named_parameters())
+          if (theirs.contains(p.key())) p.value().copy_(theirs[p.key()]);
+      }
+      auto [color, info] = random_inputs(spec, 7, 5);
+      // Recency: 0 (no sample) or one of the ages' values.
+      const auto age = torch::randint(0, 6, info.select(1, 4).sizes());
+      info.select(1, 4).copy_(torch::where(age.eq(5), torch::zeros_like(age), 1.0 - age / 5.0).to(torch::kFloat));
+      const auto empty = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).eq(0);
+      const auto sampled = ~empty;
+      const auto history = info.slice(1, 1, 4);
+      ASSERT_GT(empty.sum().item<int64_t>(), 0);
+      ASSERT_GT(sampled.sum().item<int64_t>(), 0);
+      {
+        torch::NoGradGuard no_grad;
+        const auto out = net->forward(color, info), theirs = plain->forward(color, info);
+        EXPECT_TRUE(torch::equal(out.masked_select(empty), theirs.masked_select(empty)));
+        // A fresh blend barely moves the network's image (weight sigmoid(-4) * recency < 0.02).
+        EXPECT_LT((out - theirs).abs().max().item<float>(), 0.02f * ((history - theirs).abs().max().item<float>() + 1e-6f));
+        EXPECT_FALSE(torch::equal(out, theirs));
+        // A weight of about 1 on the current frame's samples (recency 1) gives them.
+        net->rit()->blend->bias.fill_(30.0f);
+        const auto current = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).eq(1);
+        const auto taken = net->forward(color, info);
+        EXPECT_TRUE(torch::allclose(taken.masked_select(current), history.masked_select(current), 1e-5, 1e-5));
+      }
+      // The interpreter runs the blend as forward() does, in the deployed graph too.
+      {
+        torch::NoGradGuard no_grad;
+        const auto g = net->describe(/*training=*/true);
+        const auto image = graph::run(g, network_inputs(g, color, info)).front().second;
+        EXPECT_TRUE(torch::equal(image, net->forward_train(color, info).image));
+        // Deployed (branch convs folded), it is the plain network's deployed graph without a
+        // sample and the sample where its weight is 1.
+        const auto deployed = net->describe(/*training=*/false), plain_deployed = plain->describe(false);
+        EXPECT_NE(deployed.find_op("rit.blend"), nullptr);
+        const auto served = graph::run(deployed, network_inputs(deployed, color, info)).front().second;
+        const auto theirs = graph::run(plain_deployed, network_inputs(plain_deployed, color, info)).front().second;
+        EXPECT_TRUE(torch::equal(served.masked_select(empty), theirs.masked_select(empty)));
+        const auto current = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).eq(1);
+        EXPECT_TRUE(torch::allclose(served.masked_select(current), history.masked_select(current), 1e-5, 1e-5));
+      }
+      // The blend's conv is the only new parameter: (3 + 5) * 3 * 9 weights and 3 biases.
+      EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain) + 8 * 3 * 9 + 3);
+    }
+}

@@ -296,6 +296,27 @@ TEST(HistoryChannel, ANetworkReadingItTrains) {
   fs::remove_all(dir);
 }
 
+// rit.history_blend through the command line: a network blending its output with the history's
+// samples trains and exports, and ONNX Runtime and OpenCV reproduce it (the blend included).
+TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
+  const auto dir = test::scratch_dir("history-blend");
+  const auto train = test::run_cgsr(
+      "train --data " + jittered_data().string() +
+      " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
+      " --set schedule.val_frames=1 --set schedule.color_augment=true --set enhance.enabled=true"
+      " --set 'enhance.rit.channels=[depth, history]' --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4"
+      " --set enhance.rit.history_blend=true --set enhance.geometry.enabled=false --out " + (dir / "train").string());
+  ASSERT_EQ(train.exit_code, 0) << train.all();
+  const auto model = dir / "train" / "model.cgsr";
+  const auto exported = test::run_cgsr("export --model " + model.string() + " --format onnx --input 64x48 --verify --out " +
+                                       (dir / "model.onnx").string());
+  ASSERT_EQ(exported.exit_code, 0) << exported.all();
+  EXPECT_NE(exported.out.find("hr_render_info [1, 5, 96, 128]"), std::string::npos) << exported.out;  // depth 1 + history 4
+  EXPECT_NE(exported.out.find("0 failed"), std::string::npos) << exported.out;
+  EXPECT_EQ(exported.out.find(" 0 passed"), std::string::npos) << exported.out;
+  fs::remove_all(dir);
+}
+
 // `cgsr ablate` with history in a channel set: the data set is opened with the channel though it
 // is not derived by default, and the variant trains and evaluates.
 TEST(HistoryChannel, AnAblationChannelSetReadsIt) {
