@@ -23,7 +23,7 @@ namespace {
 config::Schema<PickOptions> pick_schema() {
   config::Schema<PickOptions> s;
   s.field("latency_fraction", &PickOptions::latency_fraction,
-          "latency budget of the pick, as a fraction of the full network's predicted latency").range(0.001, 1);
+          "latency budget of the pick, as a fraction of the full network's latency (predicted, then measured)").range(0.001, 1);
   s.field("latency_ms", &PickOptions::latency_ms, "latency budget in ms (when > 0; replaces latency_fraction)")
       .at_least(0);
   s.field("measure_runs", &PickOptions::measure_runs,

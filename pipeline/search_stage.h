@@ -21,7 +21,7 @@
 namespace cgsr {
 
 struct PickOptions {
-  double latency_fraction = 0.33;  // budget: this fraction of the full network's predicted latency
+  double latency_fraction = 0.33;  // budget: this fraction of the full network's latency (predicted, then measured)
   double latency_ms = 0;           // or this many ms (when > 0)
   int measure_runs = 5;            // timed runs per subnet when the pick is checked by measurement (0: not)
 };
