@@ -163,22 +163,27 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)
     problems.push_back({"rit.hr_width", config::out_of_range(spec.rit.hr_width, 1, config::kUnbounded)});
-  // The composites read a channel's samples at the output resolution.
-  const auto check_composite = [&](bool on, const std::string& key, RenderChannel channel) {
+  // The options that change the output read a channel from the raw input at the output resolution.
+  const auto check_output_option = [&](bool on, const std::string& key, RenderChannel channel, const std::string& does) {
     if (!on) return;
     const std::string name = channel_name(channel), what = "rit." + key;
     const std::vector<std::string> hr_sources(rit_sources().begin() + 1, rit_sources().end());  // lr is the first
     if (!spec.rit.enabled)
-      problems.push_back({what, "composites the output with the RIT's " + name + " channel; enable rit"});
+      problems.push_back({what, does + " the RIT's " + name + " channel; enable rit"});
     else if (std::find(rit_channels.begin(), rit_channels.end(), channel) == rit_channels.end())
-      problems.push_back({what, "composites the output with the " + name + " channel, which rit.channels [" +
-                                    join(spec.rit.channels) + "] does not list: add " + name});
+      problems.push_back({what, does + " the " + name + " channel, which rit.channels [" + join(spec.rit.channels) +
+                                    "] does not list: add " + name});
     else if (!spec.rit.reads_hr())
       problems.push_back({what, "needs the " + name + " channel at the output resolution, which rit.source lr "
                                 "does not give: use " + join(hr_sources, ", or ")});
   };
-  check_composite(spec.rit.bsp_composite, "bsp_composite", RenderChannel::Bsp);
-  check_composite(spec.rit.history_blend, "history_blend", RenderChannel::History);
+  check_output_option(spec.rit.bsp_composite, "bsp_composite", RenderChannel::Bsp, "composites the output with");
+  check_output_option(spec.rit.history_blend, "history_blend", RenderChannel::History, "blends the output with");
+  check_output_option(spec.rit.skip_at_jitter, "skip_at_jitter", RenderChannel::Jitter, "takes the image skip at");
+  if (spec.rit.skip_at_jitter && (!info.has_image_skip || spec.image_skip != ImageSkip::Bilinear))
+    problems.push_back({"rit.skip_at_jitter", info.has_image_skip
+                                                  ? "moves a bilinear image skip; image_skip is " + enum_name(spec.image_skip)
+                                                  : spec.backbone + " adds no interpolated image to its output to move"});
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -259,6 +264,9 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("history_blend", &RitSpec::history_blend,
             "blend the output with the history channel's samples by a learned weight where there is one");
   rit.omit_when("history_blend", [](const RitSpec& r) { return !r.history_blend; });
+  rit.field("skip_at_jitter", &RitSpec::skip_at_jitter,
+            "interpolate the bilinear image skip at the jitter channel's offsets (the unjittered output grid)");
+  rit.omit_when("skip_at_jitter", [](const RitSpec& r) { return !r.skip_at_jitter; });
   return rit;
 }
 
@@ -324,7 +332,8 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.feature_branch()) widths += ", w" + std::to_string(r.width);
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
-         " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") + "]";
+         " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") +
+         (r.skip_at_jitter ? ", skip at jitter" : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

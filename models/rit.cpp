@@ -46,7 +46,8 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
       info_factor_(rit.reads_hr() ? scale : 1),
       pool_factor_(rit.source == RitSource::HrPooled ? scale : 1),
       stride_(rit.unshuffles() ? scale : 1),
-      upsample_factor_(features.factor) {
+      upsample_factor_(features.factor),
+      scale_(scale) {
   const int64_t c = total_width(rit.render_channels());
   CGSR_CHECK(c > 0 && rit.width > 0 && rit.hr_width > 0, "RIT needs channels and positive widths");
   ParameterBudget::charge(c);
@@ -77,13 +78,22 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::History);
     history_color_ = selection(c, offset, 1);
     history_recency_ = selection(c, offset + 3, 0);
-    negate_scale_ = torch::full({3}, -1.0f);
-    negate_shift_ = torch::zeros({3});
     ParameterBudget::charge_conv(3 + c, 3, 3, 1, /*bias=*/true);
     blend = register_module("blend", make_conv(3 + c, 3, 3));
     zero_conv(blend);
     torch::NoGradGuard no_grad;
     blend->bias.fill_(-4.0f);
+  }
+  if (rit.skip_at_jitter) {
+    CGSR_CHECK(info_factor_ == scale, "RIT: skip_at_jitter needs the information at the output resolution");
+    const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::Jitter);
+    jitter_offsets_ = torch::zeros({2, c, 1, 1});
+    jitter_offsets_[0][offset] = 1.0f;
+    jitter_offsets_[1][offset + 1] = 1.0f;
+  }
+  if (rit.history_blend || rit.skip_at_jitter) {
+    negate_scale_ = torch::full({3}, -1.0f);
+    negate_shift_ = torch::zeros({3});
   }
 }
 
@@ -162,6 +172,24 @@ int RitBlockImpl::describe_blend_history(graph::Builder& g, int image, int info)
   const int history = g.conv("history_color", info, history_color_, {}, 0, rgb, /*trainable=*/false);
   const int negated = g.affine("history_negate", image, negate_scale_, negate_shift_, /*trainable=*/false);
   return g.add(image, g.mul(weight, g.add(history, negated)));
+}
+
+torch::Tensor RitBlockImpl::skip_at_jitter(const torch::Tensor& image, const torch::Tensor& lr_color,
+                                          const torch::Tensor& info) const {
+  // The kernels and the operand order of describe_skip_at_jitter(), so both give the same bits.
+  const auto at_jitter = graph::apply_sample(lr_color, torch::conv2d(info, jitter_offsets_), scale_,
+                                             graph::ResizeMode::Bilinear);
+  const auto unjittered = graph::apply_resize(lr_color, scale_, graph::ResizeMode::Bilinear);
+  return image + (at_jitter + graph::apply_affine(unjittered, negate_scale_, negate_shift_));
+}
+
+int RitBlockImpl::describe_skip_at_jitter(graph::Builder& g, int image, int lr_color, int info) const {
+  const int offsets = g.conv("jitter_offsets", info, jitter_offsets_, {}, 0, graph::fixed_layout("jitter", 2),
+                             /*trainable=*/false);
+  const int at_jitter = g.sample(lr_color, offsets, graph::ResizeMode::Bilinear);
+  const int unjittered = g.resize(lr_color, scale_, graph::ResizeMode::Bilinear);
+  const int negated = g.affine("skip_negate", unjittered, negate_scale_, negate_shift_, /*trainable=*/false);
+  return g.add(image, g.add(at_jitter, negated));
 }
 
 }  // namespace cgsr

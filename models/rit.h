@@ -40,6 +40,14 @@
 // weight 0 and bias -4: w under 0.02) learns how far to trust a sample from its age, the
 // G-buffers and its disagreement with the network. A network given the samples as input learned
 // nothing from them (docs/results/history.md); here using one is a single weight away.
+//
+// rit.skip_at_jitter: PAN adds the LR image, bilinearly upsampled, to its output; in a jittered
+// frame that reads each output pixel up to half an LR pixel from where its content sits. The
+// option swaps that skip for the same interpolation at the frame's jitter (the jitter channel of
+// the raw HR input): out = net + (sample(lr, jitter) - bilinear(lr)), where sample reads the LR
+// image at (j + 0.5) / s - 0.5 + jitter (graph Sample, bilinear), the unjittered output grid.
+// Without jitter (0) both interpolations are the same and the output is the network's. No
+// parameters: fixed 0/1 1x1 convs pick the jitter out of the info input.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/conv.h>
@@ -81,6 +89,10 @@ class RitBlockImpl : public torch::nn::Module {
   bool blends_history() const { return !blend.is_empty(); }
   torch::Tensor blend_history(const torch::Tensor& image, const torch::Tensor& info);
   int describe_blend_history(graph::Builder& g, int image, int info) const;
+  // rit.skip_at_jitter: the image with its bilinear skip of `lr_color` moved to the jitter of `info`.
+  bool skips_at_jitter() const { return jitter_offsets_.defined(); }
+  torch::Tensor skip_at_jitter(const torch::Tensor& image, const torch::Tensor& lr_color, const torch::Tensor& info) const;
+  int describe_skip_at_jitter(graph::Builder& g, int image, int lr_color, int info) const;
 
   bool has_feature_branch() const { return !conv.is_empty(); }
   bool has_hr_branch() const { return !hr_conv.is_empty(); }
@@ -111,6 +123,9 @@ class RitBlockImpl : public torch::nn::Module {
   // history_blend: constants, [3, C, 1, 1] selections of the history colour and of its recency
   // (broadcast to R, G, B); and -x as scale -1, shift 0.
   torch::Tensor history_color_, history_recency_, negate_scale_, negate_shift_;
+  // skip_at_jitter: a constant [2, C, 1, 1] selection of the jitter (x, y); the scale.
+  torch::Tensor jitter_offsets_;
+  int64_t scale_;
 };
 TORCH_MODULE(RitBlock);
 

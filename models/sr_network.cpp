@@ -54,8 +54,9 @@ Reconstruction SRNetworkImpl::run(const torch::Tensor& lr_color, const torch::Te
   HrFusion at_hr;
   if (rit_->has_hr_branch()) at_hr = [&](const torch::Tensor& hr) { return rit_->fuse_hr(hr, gated); };
   auto recon = backbone_->reconstruct(features, extracted.skip, at_hr);
-  // Last, on the image every caller sees (training's loss too), from the ungated input; the
-  // renderer's exact BSP borders after the history.
+  // Last, on the image every caller sees (training's loss too), from the ungated input: the skip
+  // at the jitter, then the history, then the renderer's exact BSP borders.
+  if (rit_->skips_at_jitter()) recon.image = rit_->skip_at_jitter(recon.image, lr_color, info);
   if (rit_->blends_history()) recon.image = rit_->blend_history(recon.image, info);
   if (rit_->composites_bsp()) recon.image = rit_->composite_bsp(recon.image, info);
   return recon;
@@ -130,6 +131,10 @@ graph::Graph SRNetworkImpl::describe_graph(bool training) const {
   {
     auto scope = g.scope("backbone");
     recon = backbone_->describe_reconstruct(g, features, extracted.skip, at_hr);
+  }
+  if (has_rit() && rit_->skips_at_jitter()) {
+    auto scope = g.scope("rit");
+    recon.image = rit_->describe_skip_at_jitter(g, recon.image, color, info);
   }
   if (has_rit() && rit_->blends_history()) {
     auto scope = g.scope("rit");

@@ -58,8 +58,8 @@ torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderCh
   int64_t offset = 0;
   for (auto c : channels) {
     const int width = channel_width(c);
-    if (c == RenderChannel::Normal || c == RenderChannel::Motion) {
-      // Components in image orientation: motion is (x right, y down); normals (x right, y up).
+    if (c == RenderChannel::Normal || c == RenderChannel::Motion || c == RenderChannel::Jitter) {
+      // Components in image orientation: motion and jitter are (x right, y down); normals (x right, y up).
       const bool y_up = c == RenderChannel::Normal;
       auto x = t.select(cdim, offset).clone(), y = t.select(cdim, offset + 1).clone();
       if (a.flip) x = -x;

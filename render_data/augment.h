@@ -1,11 +1,11 @@
 #pragma once
 // The 8 flips and 90-degree rotations of an image (the dihedral group), applied consistently to
 // colour and rendering information. Vectors are transformed, not only moved:
-//   image coordinates x right, y down; motion (dx, dy) is in these coordinates;
+//   image coordinates x right, y down; motion and jitter (dx, dy) are in these coordinates;
 //   normals are view space (x right, y up, z towards the camera).
-// A horizontal flip negates motion x and normal x; a vertical flip negates motion y and normal
-// y; a 90-degree counter-clockwise rotation (as displayed) maps motion (dx, dy) -> (dy, -dx) and
-// normal (x, y) -> (-y, x). Depth, normal angle, edges and colour only move.
+// A horizontal flip negates motion x, jitter x and normal x; a vertical flip negates their y; a
+// 90-degree counter-clockwise rotation (as displayed) maps motion and jitter (dx, dy) -> (dy, -dx)
+// and normal (x, y) -> (-y, x). Depth, normal angle, edges and colour only move.
 // Colour augmentation (ColorAugmentation below) changes colour values, never geometry.
 
 #include <torch/types.h>

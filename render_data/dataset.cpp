@@ -156,6 +156,10 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
       info.derived.push_back(c);
       continue;
     }
+    if (c == RenderChannel::Jitter) {  // from each LR frame's jitter (0 when not jittered): always possible
+      info.derived.push_back(c);
+      continue;
+    }
     const bool asked = std::find(derive.begin(), derive.end(), c) != derive.end();
     if (!asked || !derivable(c))
       throw Error(info.root.string(), "the dataset has no '" + channel_name(c) + "' channel (stored: " +
@@ -176,6 +180,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
       const bool derived = std::find(info.derived.begin(), info.derived.end(), c) != info.derived.end();
       const bool available = c == RenderChannel::Bsp       ? bsp_available_at(info, r)
                              : c == RenderChannel::History ? history_available_at(info, r)
+                             : c == RenderChannel::Jitter  ? true
                                                            : has(c) || (derived && has(RenderChannel::Depth));
       if (available) out.push_back(c);
     }
@@ -186,7 +191,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
 std::vector<RenderChannel> depth_derived(const DatasetInfo& info) {
   std::vector<RenderChannel> out;
   for (auto c : info.derived)
-    if (c != RenderChannel::Bsp && c != RenderChannel::History) out.push_back(c);
+    if (c != RenderChannel::Bsp && c != RenderChannel::History && c != RenderChannel::Jitter) out.push_back(c);
   return out;
 }
 
@@ -326,6 +331,10 @@ struct Dataset::Impl {
     if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::History) != info.channels.end() &&
         history_available_at(info, res))
       f.history = resolve_history(index, res, f);
+    if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Jitter) != info.channels.end()) {
+      const auto jitter = res == 0 ? f.jitter : source->load(index, 0, {}).jitter;
+      f.lr_jitter = torch::tensor({static_cast<float>(jitter[0]), static_cast<float>(jitter[1])}).view({2, 1, 1});
+    }
     return f;
   }
 
@@ -464,9 +473,9 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
       needed.push_back(c);
   };
   for (auto c : channels) need(c);
-  // Derived only when asked for (history), or kept when the data cannot give it, so that opening
-  // says what is missing and how to render it.
-  for (auto c : {RenderChannel::Bsp, RenderChannel::History})
+  // Derived only when asked for (history, jitter), or kept when the data cannot give it, so that
+  // opening says what is missing and how to render it.
+  for (auto c : {RenderChannel::Bsp, RenderChannel::History, RenderChannel::Jitter})
     if (std::find(channels.begin(), channels.end(), c) != channels.end() &&
         std::find(needed.begin(), needed.end(), c) == needed.end())
       needed.push_back(c);
@@ -481,9 +490,14 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
 Dataset open_with_asked_channels(const fs::path& path, const std::vector<RenderChannel>& channels) {
   const Dataset all = Dataset::open(path);
   auto wanted = all.info().channels;
-  const bool asked = std::find(channels.begin(), channels.end(), RenderChannel::History) != channels.end();
-  if (!asked || std::find(wanted.begin(), wanted.end(), RenderChannel::History) != wanted.end()) return all;
-  wanted.push_back(RenderChannel::History);
+  const auto has = [](const std::vector<RenderChannel>& v, RenderChannel c) { return std::find(v.begin(), v.end(), c) != v.end(); };
+  bool added = false;
+  for (auto c : {RenderChannel::History, RenderChannel::Jitter})
+    if (has(channels, c) && !has(wanted, c)) {
+      wanted.push_back(c);
+      added = true;
+    }
+  if (!added) return all;
   std::sort(wanted.begin(), wanted.end());
   DatasetOpenOptions open;
   open.channels = channel_names(wanted);

@@ -155,7 +155,7 @@ std::vector<int> spread_frames(const std::vector<int>& frames, int count);
 Dataset open_for_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
 
 // The data set at `path` with every channel it gives by default, plus those of `channels` that are
-// derived only when asked for (history): for readers that pick their channels later (`cgsr ablate`'s
+// derived only when asked for (history, jitter): for readers that pick their channels later (`cgsr ablate`'s
 // channel sets). Data that cannot give them is the error opening them names.
 Dataset open_with_asked_channels(const std::filesystem::path& path, const std::vector<RenderChannel>& channels);
 
@@ -173,9 +173,10 @@ bool looks_like_glob_layout(const std::filesystem::path& path);
 // how to render them.
 // The history channel (render_channels.h, history_channel.h) is derived only when asked for by
 // name (it reads kHistoryFrames more frames per frame); asked for on data that cannot give it at
-// any resolution it is an error naming the data set, each resolution and what it lacks.
+// any resolution it is an error naming the data set, each resolution and what it lacks. The
+// jitter channel is derived only when asked for by name, from each LR frame's jitter, on any data.
 void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options);
-// info.derived without bsp and history: the channels derive_channels computes from depth.
+// info.derived without bsp, history and jitter: the channels derive_channels computes from depth.
 std::vector<RenderChannel> depth_derived(const DatasetInfo& info);
 // s when `resolution` is s times resolutions[0] in both axes (s >= 1), else 0.
 int lr_multiple(const DatasetInfo& info, size_t resolution);

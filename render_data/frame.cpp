@@ -16,6 +16,7 @@ bool Frame::has(RenderChannel c) const {
     case RenderChannel::Motion: return motion.defined();
     case RenderChannel::Bsp: return bsp.defined();
     case RenderChannel::History: return history.defined();
+    case RenderChannel::Jitter: return lr_jitter.defined();
   }
   return false;
 }
@@ -42,6 +43,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
       case RenderChannel::Motion: parts.push_back(motion.to(torch::kFloat32)); break;
       case RenderChannel::Bsp: parts.push_back(bsp); break;
       case RenderChannel::History: parts.push_back(history); break;
+      case RenderChannel::Jitter: parts.push_back(lr_jitter.expand({2, height, width}).contiguous()); break;
     }
   }
   if (parts.empty()) return torch::zeros({0, height, width}, torch::kFloat32);
@@ -50,7 +52,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
 
 size_t Frame::bytes() const {
   size_t n = 0;
-  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp, &history})
+  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp, &history, &lr_jitter})
     if (t->defined()) n += t->numel() * t->element_size();
   if (bsp_border) n += bsp_border->bytes();
   return n;
@@ -62,6 +64,7 @@ Frame crop(const Frame& f, int x, int y, int w, int h) {
   out.width = w;
   out.height = h;
   out.jitter = f.jitter;
+  out.lr_jitter = f.lr_jitter;
   const Frame* src = &f;
   for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
                            std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},

@@ -34,6 +34,9 @@ struct Frame {
   // float32 [4,H,W]: the reprojected LR samples of this frame and its predecessors (render_channels.h,
   // derived on load from the stored channels of the previous frames; history_channel.h).
   torch::Tensor history;
+  // float32 [2,1,1]: the jitter channel (render_channels.h), the LR frame's jitter in LR pixels at
+  // every resolution, derived on load; info() spreads it over the frame, crop() keeps it.
+  torch::Tensor lr_jitter;
   DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
   // The sub-pixel BSP border image, when the data set stores one at this resolution (cgsr data
   // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are

@@ -239,7 +239,8 @@ class GlobDataset : public FrameSource {
           f.motion = decode(file(c), "motion", [&](const ImageFile& image) { return decode_capture_motion(image, motion_format_); });
           break;
         case RenderChannel::Bsp:  // never stored: resolve_channels only derives them
-        case RenderChannel::History: break;
+        case RenderChannel::History:
+        case RenderChannel::Jitter: break;
       }
     }
     return f;

@@ -19,7 +19,7 @@ const std::vector<ChannelInfo>& table() {
       {RenderChannel::Depth, "depth", 1},   {RenderChannel::Normal, "normal", 3},
       {RenderChannel::NormalAngle, "normal_angle", 1}, {RenderChannel::Edge, "edge", 1},
       {RenderChannel::Motion, "motion", 2}, {RenderChannel::Bsp, "bsp", 4},
-      {RenderChannel::History, "history", 4},
+      {RenderChannel::History, "history", 4},   {RenderChannel::Jitter, "jitter", 2},
   };
   return t;
 }

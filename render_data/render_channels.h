@@ -45,6 +45,11 @@
 //                                 when asked for by name, at every integer multiple of the LR
 //                                 resolution where motion and depth are stored (and LR depth);
 //                                 docs/temporal.md
+//   jitter          2    pixels   the LR frame's sub-pixel jitter (jitter.h), (x, y) in LR pixels
+//                                 (x right, y down, each in [-0.5, 0.5)), the same at every pixel
+//                                 and at every resolution: what an engine passes a temporal
+//                                 upscaler each frame, as two constant planes. 0 for unjittered
+//                                 data. Derived on load only when asked for by name
 
 #include <torch/types.h>
 
@@ -55,7 +60,7 @@
 
 namespace cgsr {
 
-enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp, History };
+enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp, History, Jitter };
 
 const std::vector<RenderChannel>& all_render_channels();  // in the fixed order above
 const std::string& channel_name(RenderChannel channel);

@@ -161,15 +161,17 @@ TEST(ArchSpec, ProgrammaticSpecsAreValidatedToo) {
   EXPECT_THROW(resolve_spec(s), Error);
 }
 
-// rit.bsp_composite and rit.history_blend read their channel at HR: without the channel, with
-// rit.source lr or without a RIT it is an error naming the key; each is written only when set.
+// rit.bsp_composite, rit.history_blend and rit.skip_at_jitter read their channel at HR: without
+// the channel, with rit.source lr or without a RIT it is an error naming the key; each is written
+// only when set. skip_at_jitter moves PAN's bilinear skip: another backbone or skip is an error.
 TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
   struct Composite {
     std::string key, channel, summary;
     bool RitSpec::*flag;
   };
   for (const Composite& c : {Composite{"bsp_composite", "bsp", "bsp composite", &RitSpec::bsp_composite},
-                             Composite{"history_blend", "history", "history blend", &RitSpec::history_blend}}) {
+                             Composite{"history_blend", "history", "history blend", &RitSpec::history_blend},
+                             Composite{"skip_at_jitter", "jitter", "skip at jitter", &RitSpec::skip_at_jitter}}) {
     SCOPED_TRACE(c.key);
     const std::string key = "rit." + c.key;
     const std::string missing = parse_error("backbone: pan\nrit: {enabled: true, channels: [depth, edge], source: hr_fuse, " +
@@ -203,5 +205,11 @@ TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
     } catch (const Error& e) {
       EXPECT_EQ(e.context(), "arch spec: " + key);
     }
+  }
+  for (const std::string& other : {"backbone: edsr", "backbone: pan\nimage_skip: bicubic"}) {
+    const std::string error = parse_error(other + "\nrit: {enabled: true, channels: [jitter], source: hr_fuse, skip_at_jitter: true}\n");
+    EXPECT_NE(error.find("rit.skip_at_jitter"), std::string::npos) << error;
+    EXPECT_NE(error.find(other == "backbone: edsr" ? "adds no interpolated image" : "image_skip is bicubic"), std::string::npos)
+        << error;
   }
 }

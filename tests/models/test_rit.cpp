@@ -6,6 +6,7 @@
 #include "models/importance/channel_importance.h"
 #include "models/inherit.h"
 #include "models/sr_network.h"
+#include "render_data/augment.h"
 #include "tests/models/model_cases.h"
 
 using namespace cgsr;
@@ -342,4 +343,77 @@ TEST(Rit, HistoryBlendIsTheNetworkWithoutASampleAndLearnsToTakeOne) {
       // The blend's conv is the only new parameter: (3 + 5) * 3 * 9 weights and 3 biases.
       EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain) + 8 * 3 * 9 + 3);
     }
+}
+
+// rit.skip_at_jitter at every scale and HR source: at jitter 0 the output is the same network's
+// without the option; a jitter of one whole LR pixel reads the skip one LR pixel over (x right,
+// y down), so away from the border the output moves by the skip of the shifted image; the graph
+// computes what forward() does, deployed too; no parameter is added.
+TEST(Rit, SkipAtJitterMovesPansSkipToTheJitter) {
+  torch::manual_seed(31);
+  for (int scale : {2, 3, 4})
+    for (const auto& source : rit_sources_for("pan")) {
+      if (source == "lr") continue;
+      SCOPED_TRACE(std::to_string(scale) + " " + source);
+      ArchSpec plain_spec = with_rit(default_spec("pan", scale), source);
+      plain_spec.rit.channels = {"edge", "jitter"};  // jitter at positions 1, 2: the offset counts
+      plain_spec = resolve_spec(plain_spec);
+      ArchSpec spec = plain_spec;
+      spec.rit.skip_at_jitter = true;
+      SRNetwork plain(plain_spec), net(resolve_spec(spec));
+      randomize_fusion(*plain, 0.1);
+      {
+        torch::NoGradGuard no_grad;
+        auto theirs = plain->named_parameters();
+        for (auto& p : net->named_parameters()) p.value().copy_(theirs[p.key()]);
+      }
+      EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
+      auto [color, info] = random_inputs(spec, 9, 7);
+      torch::NoGradGuard no_grad;
+      info.narrow(1, 1, 2).zero_();
+      EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
+      const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
+      const int64_t s = scale, h = color.size(2), w = color.size(3);
+      for (int axis : {0, 1}) {
+        SCOPED_TRACE(axis == 0 ? "x" : "y");
+        info.narrow(1, 1, 2).zero_();
+        info.select(1, 1 + axis).fill_(1.0f);
+        const auto moved = net->forward(color, info) - plain->forward(color, info);
+        // The LR image one pixel over: pixel x reads x + 1 (the last column or row repeats).
+        const auto shifted = axis == 0 ? torch::cat({color.narrow(3, 1, w - 1), color.narrow(3, w - 1, 1)}, 3)
+                                       : torch::cat({color.narrow(2, 1, h - 1), color.narrow(2, h - 1, 1)}, 2);
+        const auto expected = skip(shifted) - skip(color);
+        // Away from the borders, where the two clamp differently.
+        const auto inner = [&](const torch::Tensor& t) { return t.narrow(2, s, (h - 2) * s).narrow(3, s, (w - 2) * s); };
+        EXPECT_TRUE(torch::allclose(inner(moved), inner(expected), 1e-4, 1e-4))
+            << (inner(moved) - inner(expected)).abs().max().item<float>();
+      }
+      info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
+      const auto out = net->forward(color, info);
+      const auto g = net->describe(/*training=*/true);
+      EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second, out));
+      const auto deployed = net->describe(/*training=*/false);
+      EXPECT_TRUE(torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5,
+                                  1e-5));
+    }
+}
+
+// The training augmentations keep the skip at the jitter right: flipping or rotating a frame and
+// transforming its jitter like a motion vector (render_data/augment.h) gives the interpolation of
+// the flipped or rotated frame.
+TEST(Rit, AugmentedJitterSamplesTheAugmentedFrame) {
+  torch::manual_seed(37);
+  const int64_t s = 2;
+  const auto lr = torch::rand({1, 3, 6, 6});
+  auto planes = torch::empty({1, 2, 12, 12});
+  planes.select(1, 0).fill_(0.3f);
+  planes.select(1, 1).fill_(-0.2f);
+  const auto sampled = graph::apply_sample(lr, planes, s, graph::ResizeMode::Bilinear);
+  for (int i = 0; i < 8; ++i) {
+    SCOPED_TRACE(i);
+    const Augmentation a = Augmentation::from_index(i);
+    const auto moved_planes = augment_info(planes, {RenderChannel::Jitter}, a);
+    const auto of_moved = graph::apply_sample(augment_image(lr, a), moved_planes, s, graph::ResizeMode::Bilinear);
+    EXPECT_TRUE(torch::allclose(of_moved, augment_image(sampled, a), 1e-5, 1e-5));
+  }
 }

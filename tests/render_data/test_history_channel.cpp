@@ -317,6 +317,26 @@ TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
   fs::remove_all(dir);
 }
 
+// rit.skip_at_jitter with the blend through the command line: the jitter channel is derived for the
+// network, which trains and exports, and ONNX Runtime reproduces it (its GridSample included).
+TEST(HistoryChannel, ANetworkTakingItsSkipAtTheJitterTrainsAndExports) {
+  const auto dir = test::scratch_dir("skip-at-jitter");
+  const auto train = test::run_cgsr(
+      "train --data " + jittered_data().string() +
+      " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
+      " --set schedule.val_frames=1 --set enhance.enabled=true --set 'enhance.rit.channels=[depth, history, jitter]'"
+      " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4 --set enhance.rit.history_blend=true"
+      " --set enhance.rit.skip_at_jitter=true --set enhance.geometry.enabled=false --out " + (dir / "train").string());
+  ASSERT_EQ(train.exit_code, 0) << train.all();
+  const auto exported = test::run_cgsr("export --model " + (dir / "train" / "model.cgsr").string() +
+                                       " --format onnx --input 64x48 --verify --out " + (dir / "model.onnx").string());
+  ASSERT_EQ(exported.exit_code, 0) << exported.all();
+  EXPECT_NE(exported.out.find("hr_render_info [1, 7, 96, 128]"), std::string::npos) << exported.out;  // 1 + 4 + 2
+  EXPECT_NE(exported.out.find("0 failed"), std::string::npos) << exported.out;
+  EXPECT_EQ(exported.out.find(" 0 passed"), std::string::npos) << exported.out;
+  fs::remove_all(dir);
+}
+
 // `cgsr ablate` with history in a channel set: the data set is opened with the channel though it
 // is not derived by default, and the variant trains and evaluates.
 TEST(HistoryChannel, AnAblationChannelSetReadsIt) {
