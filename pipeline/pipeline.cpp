@@ -452,10 +452,12 @@ class Pipeline {
     elastic_stage_ = train_with(elastic_stage_schema(), "elastic", elastic_, {data_hash_, enhanced_stage_.hash});
   }
 
-  // Steps of the scratch control: what the pipeline gave the CG-optimized network's weights.
+  // Steps of the scratch control: what the pipeline gave the CG-optimized network's weights (an
+  // elastic network trained from scratch owes the train and enhance stages nothing).
   int scratch_steps() const {
     if (options_.scratch.steps > 0) return options_.scratch.steps;
-    return backbone_.schedule.steps + enhanced_.schedule.steps + elastic_.schedule.steps + search_.final.schedule.steps;
+    const int before = elastic_.elastic.from_scratch ? 0 : backbone_.schedule.steps + enhanced_.schedule.steps;
+    return before + elastic_.schedule.steps + search_.final.schedule.steps;
   }
 
   // A training stage: `schema` emits the config it is recorded and hashed with.

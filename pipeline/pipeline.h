@@ -8,7 +8,8 @@
 //   control  the backbone trained on with the enhance stage's schedule and seed: what the
 //            extra training alone gives, which the verdict compares CG-enhanced with   DIR/control
 //   elastic  the CG-enhanced network trained once as an elastic network: every subnet of its
-//            space works; its latency table measured                             DIR/elastic
+//            space works; its latency table measured (from_scratch: its architecture
+//            from random weights)                                                DIR/elastic
 //   search   evolution over the elastic network's subnets by inference (and random search at
 //            as many evaluations); the pick, fine-tuned with distillation: CG-optimized  DIR/search
 //   prune    hybrid pruning + magnitude baseline              DIR/prune
@@ -49,7 +50,7 @@ namespace cgsr {
 // the train stage's schedule.
 struct ScratchOptions {
   bool enabled = true;
-  int steps = 0;  // 0: as many as train + enhance + elastic + the search's fine-tuning
+  int steps = 0;  // 0: as many as train + enhance (unless elastic.from_scratch) + elastic + the search's fine-tuning
 };
 config::Schema<ScratchOptions> scratch_schema();
 

@@ -131,6 +131,7 @@ NetworkToTrain network_to_train(const TrainOptions& options) {
       throw Error("train: quantization_aware", "an elastic network's subnets train in float32; remove one of the two");
     if (options.distill.enabled())
       throw Error("train: distill", "an elastic network distils from its own full network; remove 'distill'");
+    if (options.elastic.from_scratch) t.network = SRNetwork(t.network->spec());  // the architecture, fresh weights
     ElasticNetwork elastic = make_elastic(*t.network, options.elastic.space);
     t.network = elastic.network;
     t.space.emplace(elastic.space);
@@ -139,6 +140,8 @@ NetworkToTrain network_to_train(const TrainOptions& options) {
   return t;
 }
 }  // namespace
+
+SRNetwork starting_network(const TrainOptions& options) { return network_to_train(options).network; }
 
 std::string check_train(const TrainOptions& options) {
   const NetworkToTrain t = network_to_train(options);

@@ -62,5 +62,8 @@ nlohmann::ordered_json run_train(const TrainOptions& options, const YAML::Node& 
 // model, the RIT when enhancing, the elastic space when elastic; no data is read), so a spec file
 // or an enhancement the run would refuse fails --check too. Returns a line saying what it built.
 std::string check_train(const TrainOptions& options);
+// The network that training starts from (what check_train builds): the model's weights, the RIT
+// inserted when enhancing, made elastic when asked, fresh weights when elastic.from_scratch.
+SRNetwork starting_network(const TrainOptions& options);
 
 }  // namespace cgsr

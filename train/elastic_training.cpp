@@ -30,6 +30,10 @@ config::Schema<ElasticTrainingOptions> elastic_training_schema(bool with_enabled
   if (with_enabled)
     s.field("enabled", &ElasticTrainingOptions::enabled,
             "train the network as an elastic network (sorted channels, sandwich rule)");
+  s.field("from_scratch", &ElasticTrainingOptions::from_scratch,
+          "start from random weights of the model's architecture, not its trained ones");
+  // Written only when set, so stage hashes from before the option read the same.
+  s.omit_when("from_scratch", [](const ElasticTrainingOptions& o) { return !o.from_scratch; });
   s.section("space", &ElasticTrainingOptions::space, elastic_options_schema(), "the subnets the network must hold");
   s.field("sampled", &ElasticTrainingOptions::sampled, "random subnets per step besides the full one and the smallest")
       .range(0, 16);

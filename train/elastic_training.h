@@ -34,6 +34,11 @@ struct ShrinkPhase {
 
 struct ElasticTrainingOptions {
   bool enabled = false;   // train the network as an elastic network
+  // Start from random weights of the model's architecture instead of its trained ones: the
+  // elastic network then gets every step of its training, its subnets from the first (with
+  // distill below 1 and a full-network warm-up: depth.start > 0; at distill 1 it collapses to its
+  // image skip, docs/results/elastic.md).
+  bool from_scratch = false;
   ElasticOptions space;
   int sampled = 2;        // random subnets per step besides the full network and the smallest
   double distill = 1.0;   // weight of the full network's output in a subnet's target (rest: HR)

@@ -295,6 +295,12 @@ TEST(RunCommand, CheckReadsEverySceneConfigAndWritesNothing) {
   EXPECT_NE(ok.out.find("heldout  1 scene(s), 2 frames each"), std::string::npos) << ok.out;
   EXPECT_NE(ok.out.find("cgsr run: the config is valid"), std::string::npos) << ok.out;
   EXPECT_FALSE(fs::exists(dir / "run"));
+  // The scratch control trains as long as the pick's weights did: train 6 + enhance 4 + elastic
+  // 4 + fine-tuning 2, or only the last two when the elastic network starts from scratch.
+  const CliResult steps = run_cgsr(base + " --set scratch.steps=0");
+  EXPECT_NE(steps.out.find("scratch  the pick's architecture, 16 steps"), std::string::npos) << steps.out;
+  const CliResult fresh = run_cgsr(base + " --set scratch.steps=0 --set elastic.from_scratch=true");
+  EXPECT_NE(fresh.out.find("scratch  the pick's architecture, 6 steps"), std::string::npos) << fresh.out;
 
   // The held-out scenes are read when their stage starts, after every network has trained: a
   // mistake there is found by --check, with its file and key.

@@ -3,7 +3,10 @@
 // the older nested enhance block still read.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include "core/config.h"
+#include "models/model_file.h"
 #include "pipeline/search_stage.h"
 #include "pipeline/train_stage.h"
 
@@ -37,6 +40,30 @@ TEST(StageConfigs, TheElasticStageTakesItsElasticKeysAtItsTop) {
   EXPECT_EQ(flat.elastic.sampled, 3);
   EXPECT_EQ(flat.elastic.space.quantum, 8);
   EXPECT_THROW(parse<TrainOptions>("data: d\nenabled: true\n", elastic_stage_schema()), Error);
+}
+
+// elastic.from_scratch keeps the model's architecture and drops its weights: without it the
+// elastic network computes the model's function (its channels only reordered), with it another.
+TEST(StageConfigs, AnElasticStageFromScratchStartsFromFreshWeights) {
+  torch::manual_seed(5);
+  const auto file = std::filesystem::temp_directory_path() / ("cgsr_from_scratch_" + std::to_string(::getpid()) + ".cgsr");
+  SRNetwork trained(resolve_spec(default_spec("pan", 2)));
+  save_model(file, *trained);
+  TrainOptions o = parse<TrainOptions>("data: d\nmodel: " + file.string() + "\n", elastic_stage_schema());
+  o.elastic.enabled = true;
+  EXPECT_FALSE(o.elastic.from_scratch);
+  const auto color = torch::rand({1, 3, 10, 12});
+  torch::NoGradGuard no_grad;
+  const auto expected = trained->forward(color);
+  SRNetwork inherited = starting_network(o);
+  EXPECT_TRUE(torch::allclose(inherited->forward(color), expected, 1e-5, 1e-5));
+  o = parse<TrainOptions>("data: d\nmodel: " + file.string() + "\nfrom_scratch: true\n", elastic_stage_schema());
+  o.elastic.enabled = true;
+  ASSERT_TRUE(o.elastic.from_scratch);
+  SRNetwork fresh = starting_network(o);
+  EXPECT_EQ(fresh->spec(), inherited->spec());
+  EXPECT_GT((fresh->forward(color) - expected).abs().max().item<float>(), 1e-3f);
+  std::filesystem::remove(file);
 }
 
 TEST(StageConfigs, TheEnhanceStageTakesRitAndGeometryAtItsTop) {
