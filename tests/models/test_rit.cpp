@@ -12,6 +12,22 @@
 using namespace cgsr;
 using namespace cgsr::test;
 
+// A network with the RIT output option `option` set and the same network without it, reading
+// `channels`; the RIT's fusion randomized, every parameter the plain one has shared.
+std::pair<SRNetwork, SRNetwork> with_and_without(ArchSpec spec, std::vector<std::string> channels, bool RitSpec::*option) {
+  spec.rit.channels = std::move(channels);
+  const ArchSpec plain_spec = resolve_spec(spec);
+  spec = plain_spec;
+  spec.rit.*option = true;
+  SRNetwork plain(plain_spec), net(resolve_spec(spec));
+  randomize_fusion(*plain, 0.1);
+  torch::NoGradGuard no_grad;
+  auto theirs = plain->named_parameters();
+  for (auto& p : net->named_parameters())
+    if (theirs.contains(p.key())) p.value().copy_(theirs[p.key()]);
+  return {plain, net};
+}
+
 TEST(Rit, EnhancedNetworkEqualsItsBackboneAtInitialization) {
   torch::manual_seed(3);
   for (const auto& c : all_backbone_cases()) {
@@ -232,19 +248,9 @@ TEST(Rit, BspCompositeIsTheBspImageWhereCoveredAndTheNetworkElsewhere) {
     for (const auto& source : rit_sources_for(c.backbone)) {
       if (source == "lr") continue;
       SCOPED_TRACE(case_name(c) + " " + source);
-      ArchSpec plain_spec = with_rit(spec_for(c), source);
-      plain_spec.rit.channels = {"edge", "bsp"};  // bsp at positions 1..4: the selection's offset counts
-      plain_spec = resolve_spec(plain_spec);
-      ArchSpec spec = plain_spec;
-      spec.rit.bsp_composite = true;
-      SRNetwork plain(plain_spec), net(resolve_spec(spec));
-      randomize_fusion(*plain, 0.1);
-      {
-        torch::NoGradGuard no_grad;
-        auto theirs = plain->named_parameters();
-        for (auto& p : net->named_parameters()) p.value().copy_(theirs[p.key()]);
-      }
-      auto [color, info] = random_inputs(spec, 7, 5);
+      // bsp at positions 1..4: the selection's offset counts
+      auto [plain, net] = with_and_without(with_rit(spec_for(c), source), {"edge", "bsp"}, &RitSpec::bsp_composite);
+      auto [color, info] = random_inputs(net->spec(), 7, 5);
       info.select(1, 4).copy_(torch::rand_like(info.select(1, 4)).gt(0.6));  // coverage: 0 or 1
       const auto covered = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).to(torch::kBool);
       const auto bsp = info.slice(1, 1, 4);
@@ -289,20 +295,9 @@ TEST(Rit, HistoryBlendIsTheNetworkWithoutASampleAndLearnsToTakeOne) {
     for (const auto& source : rit_sources_for(c.backbone)) {
       if (source == "lr") continue;
       SCOPED_TRACE(case_name(c) + " " + source);
-      ArchSpec plain_spec = with_rit(spec_for(c), source);
-      plain_spec.rit.channels = {"edge", "history"};  // history at positions 1..4: the offset counts
-      plain_spec = resolve_spec(plain_spec);
-      ArchSpec spec = plain_spec;
-      spec.rit.history_blend = true;
-      SRNetwork plain(plain_spec), net(resolve_spec(spec));
-      randomize_fusion(*plain, 0.1);
-      {
-        torch::NoGradGuard no_grad;
-        auto theirs = plain->named_parameters();
-        for (auto& p : net->named_parameters())
-          if (theirs.contains(p.key())) p.value().copy_(theirs[p.key()]);
-      }
-      auto [color, info] = random_inputs(spec, 7, 5);
+      // history at positions 1..4: the offset counts
+      auto [plain, net] = with_and_without(with_rit(spec_for(c), source), {"edge", "history"}, &RitSpec::history_blend);
+      auto [color, info] = random_inputs(net->spec(), 7, 5);
       // Recency: 0 (no sample) or one of the ages' values.
       const auto age = torch::randint(0, 6, info.select(1, 4).sizes());
       info.select(1, 4).copy_(torch::where(age.eq(5), torch::zeros_like(age), 1.0 - age / 5.0).to(torch::kFloat));
@@ -355,20 +350,11 @@ TEST(Rit, SkipAtJitterMovesPansSkipToTheJitter) {
     for (const auto& source : rit_sources_for("pan")) {
       if (source == "lr") continue;
       SCOPED_TRACE(std::to_string(scale) + " " + source);
-      ArchSpec plain_spec = with_rit(default_spec("pan", scale), source);
-      plain_spec.rit.channels = {"edge", "jitter"};  // jitter at positions 1, 2: the offset counts
-      plain_spec = resolve_spec(plain_spec);
-      ArchSpec spec = plain_spec;
-      spec.rit.skip_at_jitter = true;
-      SRNetwork plain(plain_spec), net(resolve_spec(spec));
-      randomize_fusion(*plain, 0.1);
-      {
-        torch::NoGradGuard no_grad;
-        auto theirs = plain->named_parameters();
-        for (auto& p : net->named_parameters()) p.value().copy_(theirs[p.key()]);
-      }
+      // jitter at positions 1, 2: the offset counts
+      auto [plain, net] =
+          with_and_without(with_rit(default_spec("pan", scale), source), {"edge", "jitter"}, &RitSpec::skip_at_jitter);
       EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
-      auto [color, info] = random_inputs(spec, 9, 7);
+      auto [color, info] = random_inputs(net->spec(), 9, 7);
       torch::NoGradGuard no_grad;
       info.narrow(1, 1, 2).zero_();
       EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));

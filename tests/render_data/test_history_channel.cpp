@@ -296,45 +296,39 @@ TEST(HistoryChannel, ANetworkReadingItTrains) {
   fs::remove_all(dir);
 }
 
-// rit.history_blend through the command line: a network blending its output with the history's
-// samples trains and exports, and ONNX Runtime and OpenCV reproduce it (the blend included).
-TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
-  const auto dir = test::scratch_dir("history-blend");
+// A PAN x2 network with an HR RIT reading `rit` (--set options) trains 2 steps on the jittered
+// frames and exports to ONNX, `hr_info` the shape of its HR input, and the runtimes reproduce it.
+void expect_trains_and_exports(const std::string& scratch, const std::string& rit, const std::string& hr_info) {
+  const auto dir = test::scratch_dir(scratch);
   const auto train = test::run_cgsr(
       "train --data " + jittered_data().string() +
       " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
-      " --set schedule.val_frames=1 --set schedule.color_augment=true --set enhance.enabled=true"
-      " --set 'enhance.rit.channels=[depth, history]' --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4"
-      " --set enhance.rit.history_blend=true --set enhance.geometry.enabled=false --out " + (dir / "train").string());
+      " --set schedule.val_frames=1 --set schedule.color_augment=true --set enhance.enabled=true " + rit +
+      " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4 --set enhance.geometry.enabled=false --out " +
+      (dir / "train").string());
   ASSERT_EQ(train.exit_code, 0) << train.all();
-  const auto model = dir / "train" / "model.cgsr";
-  const auto exported = test::run_cgsr("export --model " + model.string() + " --format onnx --input 64x48 --verify --out " +
-                                       (dir / "model.onnx").string());
+  const auto exported = test::run_cgsr("export --model " + (dir / "train" / "model.cgsr").string() +
+                                       " --format onnx --input 64x48 --verify --out " + (dir / "model.onnx").string());
   ASSERT_EQ(exported.exit_code, 0) << exported.all();
-  EXPECT_NE(exported.out.find("hr_render_info [1, 5, 96, 128]"), std::string::npos) << exported.out;  // depth 1 + history 4
+  EXPECT_NE(exported.out.find("hr_render_info " + hr_info), std::string::npos) << exported.out;
   EXPECT_NE(exported.out.find("0 failed"), std::string::npos) << exported.out;
   EXPECT_EQ(exported.out.find(" 0 passed"), std::string::npos) << exported.out;
   fs::remove_all(dir);
 }
 
-// rit.skip_at_jitter with the blend through the command line: the jitter channel is derived for the
-// network, which trains and exports, and ONNX Runtime reproduces it (its GridSample included).
+// rit.history_blend through the command line: ONNX Runtime and OpenCV reproduce the blend.
+TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
+  expect_trains_and_exports("history-blend", "--set 'enhance.rit.channels=[depth, history]' --set enhance.rit.history_blend=true",
+                            "[1, 5, 96, 128]");  // depth 1 + history 4
+}
+
+// rit.skip_at_jitter with the blend: the jitter channel is derived for the network, and ONNX
+// Runtime reproduces it (its GridSample included; OpenCV DNN has none).
 TEST(HistoryChannel, ANetworkTakingItsSkipAtTheJitterTrainsAndExports) {
-  const auto dir = test::scratch_dir("skip-at-jitter");
-  const auto train = test::run_cgsr(
-      "train --data " + jittered_data().string() +
-      " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
-      " --set schedule.val_frames=1 --set enhance.enabled=true --set 'enhance.rit.channels=[depth, history, jitter]'"
-      " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4 --set enhance.rit.history_blend=true"
-      " --set enhance.rit.skip_at_jitter=true --set enhance.geometry.enabled=false --out " + (dir / "train").string());
-  ASSERT_EQ(train.exit_code, 0) << train.all();
-  const auto exported = test::run_cgsr("export --model " + (dir / "train" / "model.cgsr").string() +
-                                       " --format onnx --input 64x48 --verify --out " + (dir / "model.onnx").string());
-  ASSERT_EQ(exported.exit_code, 0) << exported.all();
-  EXPECT_NE(exported.out.find("hr_render_info [1, 7, 96, 128]"), std::string::npos) << exported.out;  // 1 + 4 + 2
-  EXPECT_NE(exported.out.find("0 failed"), std::string::npos) << exported.out;
-  EXPECT_EQ(exported.out.find(" 0 passed"), std::string::npos) << exported.out;
-  fs::remove_all(dir);
+  expect_trains_and_exports("skip-at-jitter",
+                            "--set 'enhance.rit.channels=[depth, history, jitter]' --set enhance.rit.history_blend=true"
+                            " --set enhance.rit.skip_at_jitter=true",
+                            "[1, 7, 96, 128]");  // 1 + 4 + 2
 }
 
 // `cgsr ablate` with history in a channel set: the data set is opened with the channel though it
