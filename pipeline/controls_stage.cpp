@@ -2,8 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/atomic_file.h"
 #include "core/yaml_json.h"
-#include "models/latency_table.h"
+#include "eval/relative_latency.h"
 #include "models/model_file.h"
 #include "render_data/dataset.h"
 #include "render_data/patch_sampler.h"
@@ -17,25 +18,46 @@ config::Schema<ControlsOptions> controls_schema() {
   return s;
 }
 
+namespace {
+constexpr int kTimedRuns = 7;  // interleaved rounds per control timed
+}  // namespace
+
 nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, bool resume) {
   Model enhanced = load_model(job.enhanced);
   Model final_network = load_model(job.final_model);
   const Dataset data = open_for_channels(job.data, enhanced.network->input_channels());
-  const Resolution lr = data.resolutions()[resolution_pair(data, enhanced.network->spec().scale).first];
-  final_network.network->eval();
-  const double target = measure_graph_latency(final_network.network->describe(false), lr.width, lr.height, /*runs=*/7);
   const std::string base = enhanced.provenance.extra.value("name", std::filesystem::path(job.enhanced).stem().string());
-  spdlog::info("controls: cut {} to the latency of {} ({:.1f} ms at {}x{})", base, job.final_model, target, lr.width,
-               lr.height);
+  const std::string final_name =
+      final_network.provenance.extra.value("name", std::filesystem::path(job.final_model).stem().string());
+  // Matched on latency as the report measures it: against the final network, in interleaved rounds.
+  const LatencyReference timer(std::make_unique<NetworkUpscaler>(final_name, final_network.network), data,
+                               data.frames(Split::Val), kTimedRuns);
+  const NetworkCost fraction = [&](const SRNetwork& network) {
+    NetworkUpscaler upscaler("control", network);
+    return timer.time(upscaler).fraction();
+  };
+  spdlog::info("controls: cut {} to the latency of {}", base, final_name);
   nlohmann::ordered_json results;
-  results["target_latency_ms"] = target;
+  results["latency_of"] = job.final_model;
   results["controls"] = nlohmann::ordered_json::array();
   for (const ControlKind kind : job.options.kinds) {
-    ControlNetwork control = control_at_latency(*enhanced.network, kind, target, measured_latency(lr.width, lr.height));
     const std::string name = base + " " + control_label(kind);
     const std::string stem = enum_name(kind);
-    spdlog::info("{}: keep rate {:.3f}, {:.1f} ms; fine-tuning {} steps", name, control.rate, control.latency_ms,
-                 job.schedule.steps);
+    // The cut is kept: timings differ between runs, and a resumed fine-tuning needs its network.
+    const auto cut_file = run_dir.file("cut_" + stem + ".json");
+    ControlNetwork control;
+    if (resume && std::filesystem::exists(cut_file)) {
+      const auto cut = nlohmann::json::parse(read_file(cut_file));
+      const double cost = cut.at("latency_fraction").get<double>();
+      control = control_at_rate(*enhanced.network, kind, cut.at("keep_rate").get<double>(),
+                                [&](const SRNetwork&) { return cost; });
+    } else {
+      control = control_at_latency(*enhanced.network, kind, 1.0, fraction);
+      write_file_atomic(cut_file,
+                        nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
+    }
+    spdlog::info("{}: keep rate {:.3f}, {:.2f}x {}'s latency; fine-tuning {} steps", name, control.rate, control.cost,
+                 final_name, job.schedule.steps);
     TrainHooks hooks;
     if (job.distill > 0) hooks = distillation_hooks(load_model(job.enhanced).network, job.distill, job.loss.image_norm);
     Trainer trainer(control.network, data, job.schedule, job.loss, {}, hooks);
@@ -51,7 +73,7 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
                                    {"name", name},
                                    {"file", file.string()},
                                    {"keep_rate", control.rate},
-                                   {"latency_ms", control.latency_ms},
+                                   {"latency_fraction", control.cost},
                                    {"spec", spec_summary(control.network->spec())},
                                    {"training", to_json(outcome)}});
   }

@@ -1,11 +1,12 @@
 #pragma once
 // The controls stage of `cgsr run`: what a compressed network is measured against at equal
 // latency (pruning/equal_latency_controls.h). The CG-enhanced network is narrowed by weight
-// magnitude to the final network's latency, measured on the fused path in this process: the
-// pruning units alone (MMP), or every layer group alike (uniform width). Each control is then
-// fine-tuned like the final network: the same schedule and the same distillation weight, its
-// teacher the CG-enhanced network it was cut from. Writes <kind>.cgsr per control and
-// results.json (`controls`: name, file, rate, measured and target latency).
+// magnitude to the final network's latency, timed against it as the report times its rows
+// (eval/relative_latency.h): the pruning units alone (MMP), or every layer group alike (uniform
+// width). Each control is then fine-tuned like the final network: the same schedule and the same
+// distillation weight, its teacher the CG-enhanced network it was cut from. Writes <kind>.cgsr
+// and cut_<kind>.json (the rate, kept for a resumed run) per control, and results.json
+// (`controls`: name, file, keep rate, latency as a fraction of the final network's).
 
 #include <nlohmann/json.hpp>
 #include <string>

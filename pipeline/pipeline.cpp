@@ -343,11 +343,15 @@ class Pipeline {
     line("enhance", fmt::format("RIT from {}, {}", enum_name(enhanced_.enhance.rit.source), schedule(enhanced_.schedule)));
     line("control", "the same without the RIT");
     line("elastic", fmt::format("{} subnets per step, {}", elastic_.elastic.sampled + 1, schedule(elastic_.schedule)));
-    line("search", fmt::format("{}, population {} over {} generations{}; the pick within {:g} of the full latency, "
-                               "fine-tuned {}",
+    const std::string budget =
+        search_.pick.latency_ms > 0
+            ? fmt::format("{:g} ms", search_.pick.latency_ms)
+            : fmt::format("{:g} of {}'s latency", search_.pick.latency_fraction,
+                          search_.pick.reference.empty() ? "the full network" : search_.pick.reference);
+    line("search", fmt::format("{}, population {} over {} generations{}; the pick within {}, fine-tuned {}",
                                search_.search.strategy.type, search_.search.population, search_.search.generations,
-                               search_.baseline.empty() ? "" : ", and " + search_.baseline + " search as many",
-                               search_.pick.latency_fraction, schedule(search_.final.schedule)));
+                               search_.baseline.empty() ? "" : ", and " + search_.baseline + " search as many", budget,
+                               schedule(search_.final.schedule)));
     line("prune", fmt::format("{} patterns of the front, fine-tuning {}", prune_.pool.latency_factors.size(),
                               schedule(prune_.finetune.schedule)));
     if (options_.scratch.enabled) line("scratch", fmt::format("the pick's architecture, {} steps", scratch_steps()));
@@ -405,6 +409,8 @@ class Pipeline {
     YAML::Node search_filled = YAML::Clone(with_data);
     search_filled["model"] = model_file("elastic").string();
     search_ = parse_stage(options_.search, search_command_schema(), search_filled, "search");
+    // The pick's budget is a fraction of what the verdict's latency check divides by: the backbone.
+    if (search_.pick.reference.empty() && search_.pick.measure_runs > 0) search_.pick.reference = model_file("train").string();
     // From scratch: the pick's architecture (the search writes it) with the train stage's schedule.
     scratch_ = backbone_;
     scratch_.model = (stages_.dir("search") / "pick_spec.yaml").string();

@@ -9,11 +9,13 @@
 #include "core/error.h"
 #include "core/plot.h"
 #include "core/yaml_json.h"
+#include "eval/relative_latency.h"
 #include "models/complexity.h"
 #include "models/elastic.h"
 #include "models/latency_table.h"
 #include "models/model_file.h"
 #include "models/subnet.h"
+#include "pipeline/eval_stage.h"
 #include "render_data/dataset.h"
 #include "train/distillation.h"
 
@@ -23,12 +25,19 @@ namespace {
 config::Schema<PickOptions> pick_schema() {
   config::Schema<PickOptions> s;
   s.field("latency_fraction", &PickOptions::latency_fraction,
-          "latency budget of the pick, as a fraction of the full network's latency (predicted, then measured)").range(0.001, 1);
+          "latency budget of the pick, as a fraction of the reference's latency (predicted, then measured)")
+      .range(0.001, 1);
   s.field("latency_ms", &PickOptions::latency_ms, "latency budget in ms (when > 0; replaces latency_fraction)")
       .at_least(0);
+  s.field("reference", &PickOptions::reference,
+          "model file the subnets are timed against, whose latency latency_fraction is of (\"\": the full network)");
   s.field("measure_runs", &PickOptions::measure_runs,
           "timed runs per subnet when the pick is checked by measured latency (0: the table's prediction decides)")
       .range(0, 100);
+  s.validate([](const PickOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (!o.reference.empty() && o.measure_runs == 0)
+      at.child("reference").fail(node["reference"], "a reference is timed: it needs measure_runs > 0");
+  });
   return s;
 }
 
@@ -45,47 +54,88 @@ nlohmann::ordered_json candidate_json(const Candidate& c) {
           {"subnet", to_json(c.subnet)}};
 }
 
-// The pick as measured against the full network, kept in pick.json: timings differ between
-// runs, so a search resumed after its pick fine-tunes the subnet it measured, not another.
+// The pick as measured against the reference, kept in pick.json: timings differ between runs,
+// so a search resumed after its pick fine-tunes the subnet it measured, not another.
 struct MeasuredChoice {
-  MeasuredPick measured;
-  double full_ms = 0;
+  MeasuredPick measured;  // its values in the budget's unit: ms, or a fraction of the reference
+  std::string reference;  // what the subnets were timed against ("": not timed)
+  RelativeLatency full;   // the full network against it
+  std::map<std::string, RelativeLatency> timed;  // every subnet timed, by key
+  double predicted_budget_ms = 0;                // the budget in the latency table's terms
 };
 
+nlohmann::ordered_json to_json(const RelativeLatency& r) { return {{"ms", r.ms}, {"reference_ms", r.reference_ms}}; }
+RelativeLatency relative_latency_from(const nlohmann::json& j) {
+  return {j.at("ms").get<double>(), j.at("reference_ms").get<double>()};
+}
+
 nlohmann::ordered_json to_json(const MeasuredChoice& c) {
-  nlohmann::ordered_json j = {{"key", c.measured.pick.key}, {"ms", c.measured.measured_ms}, {"full_ms", c.full_ms},
-                              {"fits", c.measured.fits}, {"timed", nlohmann::ordered_json::array()}};
-  for (const auto& [key, ms] : c.measured.timed) j["timed"].push_back({{"key", key}, {"ms", ms}});
+  nlohmann::ordered_json j = {{"key", c.measured.pick.key}, {"fits", c.measured.fits}, {"reference", c.reference},
+                              {"predicted_budget_ms", c.predicted_budget_ms}, {"full", to_json(c.full)},
+                              {"timed", nlohmann::ordered_json::array()}};
+  for (const auto& [key, value] : c.measured.timed) {
+    nlohmann::ordered_json t = to_json(c.timed.at(key));
+    t["key"] = key;
+    j["timed"].push_back(t);
+  }
   return j;
 }
 
-MeasuredChoice measured_choice(const SRNetworkImpl& net, const Candidate& full, const std::vector<Candidate>& front,
-                               double predicted_budget, const LatencyTable& table,
-                               const SearchCommandOptions& options, const std::filesystem::path& file) {
+// The pick by the table's prediction alone.
+MeasuredChoice predicted_choice(const Candidate& full, const std::vector<Candidate>& front, const PickOptions& options) {
+  MeasuredChoice c;
+  c.predicted_budget_ms = options.latency_ms > 0 ? options.latency_ms : options.latency_fraction * full.score.latency_ms;
+  c.measured.pick = pick_within(front, c.predicted_budget_ms);
+  return c;
+}
+
+// The pick by measured latency: the full network and the front's subnets timed against the
+// reference; the table's budget is the measured one scaled by the full network's prediction error.
+MeasuredChoice measured_choice(const SRNetwork& net, const Candidate& full, const std::vector<Candidate>& front,
+                               const Dataset& data, const SearchCommandOptions& options,
+                               const std::filesystem::path& file) {
+  const bool absolute = options.pick.latency_ms > 0;
+  const double budget = absolute ? options.pick.latency_ms : options.pick.latency_fraction;
+  const auto value = [&](const RelativeLatency& r) { return absolute ? r.ms : r.fraction(); };
   MeasuredChoice c;
   if (options.resume && std::filesystem::exists(file)) {
     const auto j = nlohmann::json::parse(read_file(file));
+    if (!j.contains("reference"))
+      throw Error(file.string(), "was written by an older cgsr (no reference); delete it to time the front again");
     const auto key = j.at("key").get<std::string>();
     const auto it = std::find_if(front.begin(), front.end(), [&](const Candidate& f) { return f.key == key; });
     if (it == front.end()) throw Error(file.string(), "names subnet " + key + ", which is not on the search's front");
     c.measured.pick = *it;
-    c.measured.measured_ms = j.at("ms").get<double>();
     c.measured.fits = j.at("fits").get<bool>();
-    for (const auto& t : j.at("timed")) c.measured.timed.emplace_back(t.at("key").get<std::string>(), t.at("ms").get<double>());
-    c.full_ms = j.at("full_ms").get<double>();
+    c.reference = j.at("reference").get<std::string>();
+    c.predicted_budget_ms = j.at("predicted_budget_ms").get<double>();
+    c.full = relative_latency_from(j.at("full"));
+    for (const auto& t : j.at("timed")) {
+      const auto timed_key = t.at("key").get<std::string>();
+      c.timed[timed_key] = relative_latency_from(t);
+      c.measured.timed.emplace_back(timed_key, value(c.timed[timed_key]));
+    }
+    c.measured.measured = value(c.timed.at(key));
     spdlog::info("search: the pick measured before, from {}", file.string());
     return c;
   }
-  const auto time = [&](const SubnetConfig& sub) {
-    return measure_graph_latency(subnet_graph(net, sub), table.lr_width, table.lr_height, options.pick.measure_runs);
+  std::unique_ptr<Upscaler> reference =
+      options.pick.reference.empty() ? std::make_unique<NetworkUpscaler>("the full network", net)
+                                     : make_upscaler(options.pick.reference, "", net->spec().scale);
+  c.reference = reference->name();
+  const LatencyReference timer(std::move(reference), data, data.frames(Split::Val), options.pick.measure_runs);
+  const auto time = [&](const Candidate& sub) {
+    NetworkUpscaler upscaler(sub.key, materialize_subnet(*net, sub.subnet, /*geometry_head=*/false));
+    return c.timed[sub.key] = timer.time(upscaler);
   };
-  c.full_ms = time(full.subnet);
-  const double budget =
-      options.pick.latency_ms > 0 ? options.pick.latency_ms : options.pick.latency_fraction * c.full_ms;
-  c.measured = pick_measured(front, predicted_budget, budget, [&](const Candidate& f) { return time(f.subnet); });
-  spdlog::info("search: {} subnets timed on the fused path (the full network: {:.1f} ms); the best within {:.1f} ms "
-               "measures {:.1f} ms{}",
-               c.measured.timed.size(), c.full_ms, budget, c.measured.measured_ms,
+  c.full = time(full);
+  c.predicted_budget_ms = full.score.latency_ms * budget / value(c.full);
+  c.measured = pick_measured(front, c.predicted_budget_ms, budget, [&](const Candidate& f) { return value(time(f)); });
+  const RelativeLatency& pick = c.timed.at(c.measured.pick.key);
+  spdlog::info("search: {} subnets timed against {} (the full network: {:.1f} against {:.1f} ms); the best within "
+               "{:g}{} measures {:.1f} against {:.1f} ms ({:.1f}%){}",
+               c.measured.timed.size(), c.reference, c.full.ms, c.full.reference_ms, budget,
+               absolute ? " ms" : " of it", pick.ms, pick.reference_ms, 100 * pick.fraction(),
                c.measured.fits ? "" : " (none fits: the fastest)");
   write_file_atomic(file, to_json(c).dump(2) + "\n");
   return c;
@@ -191,13 +241,12 @@ nlohmann::ordered_json run_search_command(const SearchCommandOptions& options, c
   const double latency_ref = full.score.latency_ms;
   for (auto& r : runs) r.hypervolume = front_hypervolume(r.result.front, latency_ref, quality_ref);
 
-  const double budget = options.pick.latency_ms > 0 ? options.pick.latency_ms
-                                                    : options.pick.latency_fraction * full.score.latency_ms;
   const std::vector<Candidate>& front = runs.front().result.front;
-  const MeasuredChoice choice = options.pick.measure_runs > 0
-                                    ? measured_choice(*elastic.network, full, front, budget, table, options,
-                                                      run_dir.file("pick.json"))
-                                    : MeasuredChoice{{pick_within(front, budget), 0, false, {}}, 0};
+  const MeasuredChoice choice =
+      options.pick.measure_runs > 0
+          ? measured_choice(elastic.network, full, front, data, options, run_dir.file("pick.json"))
+          : predicted_choice(full, front, options.pick);
+  const double budget = choice.predicted_budget_ms;
   const Candidate& pick = choice.measured.pick;
   write_front_plot(run_dir.file("front.png"), runs, full, pick, budget);
   spdlog::info("search: pick {} at {:.1f} ms predicted ({:.0f}% of the full network's {:.1f} ms), {:.3f} dB "

@@ -5,8 +5,9 @@
 // inference on validation crops against the latency table stored with the network, and random
 // search with as many evaluations is its control; both fronts, their hypervolumes and a plot are
 // written. The pick, the best subnet within the latency budget (predicted, then checked by
-// measurement on the fused path against the full network's), is materialized as a network of
-// its own and fine-tuned with distillation from the full network: model.cgsr.
+// measurement against a reference network's, as the report times them: eval/relative_latency.h),
+// is materialized as a network of its own and fine-tuned with distillation from the full network:
+// model.cgsr.
 // history.jsonl (and random_history.jsonl) record every subnet and are the checkpoint of --resume.
 
 #include <nlohmann/json.hpp>
@@ -21,8 +22,11 @@
 namespace cgsr {
 
 struct PickOptions {
-  double latency_fraction = 0.33;  // budget: this fraction of the full network's latency (predicted, then measured)
+  double latency_fraction = 0.33;  // budget: this fraction of the reference's latency (predicted, then measured)
   double latency_ms = 0;           // or this many ms (when > 0)
+  // The model file the fraction is of ("": the full network). `cgsr run` names its backbone
+  // (PAN x2), the network the verdict's latency check divides by.
+  std::string reference;
   int measure_runs = 5;            // timed runs per subnet when the pick is checked by measurement (0: not)
 };
 

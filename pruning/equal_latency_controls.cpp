@@ -8,7 +8,6 @@
 
 #include "core/error.h"
 #include "models/elastic.h"
-#include "models/latency_table.h"
 #include "pruning/prunable_units.h"
 
 namespace cgsr {
@@ -35,32 +34,28 @@ SubnetConfig control_subnet(const SRNetworkImpl& net, ControlKind kind, double r
   return sub;
 }
 
-GraphCost measured_latency(int64_t lr_width, int64_t lr_height, int runs) {
-  return [=](const graph::Graph& g) { return measure_graph_latency(g, lr_width, lr_height, runs); };
-}
-
-ControlNetwork control_at_rate(const SRNetworkImpl& net, ControlKind kind, double rate, const GraphCost& cost) {
+ControlNetwork control_at_rate(const SRNetworkImpl& net, ControlKind kind, double rate, const NetworkCost& cost) {
   // Sorting by magnitude makes the leading channels the largest (make_elastic's order).
   const SRNetwork sorted = make_elastic(net, ElasticOptions{}).network;
   ControlNetwork c;
   c.rate = rate;
   c.network = materialize_subnet(*sorted, control_subnet(*sorted, kind, rate), /*geometry_head=*/false);
   c.network->eval();
-  c.latency_ms = cost(c.network->describe(false));
+  c.cost = cost(c.network);
   return c;
 }
 
-ControlNetwork control_at_latency(const SRNetworkImpl& net, ControlKind kind, double latency_ms, const GraphCost& cost,
+ControlNetwork control_at_latency(const SRNetworkImpl& net, ControlKind kind, double target, const NetworkCost& cost,
                                   int steps) {
   double low = 0.05, high = 1.0;
   ControlNetwork best = control_at_rate(net, kind, high, cost);
-  if (best.latency_ms <= latency_ms) return best;
+  if (best.cost <= target) return best;
   best = control_at_rate(net, kind, low, cost);
-  if (best.latency_ms > latency_ms) return best;
+  if (best.cost > target) return best;
   for (int i = 0; i < steps; ++i) {
     const double mid = 0.5 * (low + high);
     ControlNetwork c = control_at_rate(net, kind, mid, cost);
-    if (c.latency_ms <= latency_ms) {
+    if (c.cost <= target) {
       low = mid;
       best = std::move(c);
     } else {

@@ -9,17 +9,17 @@
 //              fraction: the network scaled uniformly in width
 //
 // Both are subnets (models/subnet.h) of the network with its channels sorted by magnitude, so
-// "the leading channels" are the largest. The rate is found for a latency measured on the
-// fused path, so a control runs as fast as the network it is compared with.
+// "the leading channels" are the largest. The rate is found for a cost, which the pipeline
+// measures as latency against the final network's (pipeline/controls_stage.cpp), so a control
+// runs as fast as the network it is compared with.
 //
-//   ControlNetwork mmp = control_at_latency(*enhanced, ControlKind::Magnitude, final_ms, measured_latency(320, 240));
+//   ControlNetwork mmp = control_at_latency(*enhanced, ControlKind::Magnitude, 1.0, fraction_of_final);
 
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "core/enum_names.h"
-#include "models/graph.h"
 #include "models/sr_network.h"
 #include "models/subnet.h"
 
@@ -38,23 +38,21 @@ std::string control_label(ControlKind kind);
 // The subnet of `net` (its channels sorted by magnitude) that keeps `rate` of the chosen groups.
 SubnetConfig control_subnet(const SRNetworkImpl& net, ControlKind kind, double rate);
 
-// What a control's rate is matched on: a cost of its inference graph that grows with width.
-using GraphCost = std::function<double(const graph::Graph&)>;
-// The fused path's median latency (ms) at an LR size: the cost the pipeline matches on.
-GraphCost measured_latency(int64_t lr_width, int64_t lr_height, int runs = 5);
+// What a control's rate is matched on: a cost of the network that grows with width.
+using NetworkCost = std::function<double(const SRNetwork&)>;
 
 struct ControlNetwork {
   SRNetwork network{nullptr};  // standalone, the geometry head dropped
   double rate = 1;
-  double latency_ms = 0;       // its cost, as the matching measured it
+  double cost = 0;             // as the matching measured it
 };
 
-// The largest rate whose control costs at most `latency_ms` (bisection, `steps` halvings); the
+// The largest rate whose control costs at most `target` (bisection, `steps` halvings); the
 // smallest rate when none does.
-ControlNetwork control_at_latency(const SRNetworkImpl& net, ControlKind kind, double latency_ms, const GraphCost& cost,
+ControlNetwork control_at_latency(const SRNetworkImpl& net, ControlKind kind, double target, const NetworkCost& cost,
                                   int steps = 6);
 
 // The control at a given rate, with its cost.
-ControlNetwork control_at_rate(const SRNetworkImpl& net, ControlKind kind, double rate, const GraphCost& cost);
+ControlNetwork control_at_rate(const SRNetworkImpl& net, ControlKind kind, double rate, const NetworkCost& cost);
 
 }  // namespace cgsr

@@ -175,7 +175,7 @@ const Candidate& pick_within(const std::vector<Candidate>& front, double budget_
 }
 
 MeasuredPick pick_measured(const std::vector<Candidate>& front, double predicted_budget_ms,
-                           double measured_budget_ms, const std::function<double(const Candidate&)>& measure,
+                           double measured_budget, const std::function<double(const Candidate&)>& measure,
                            double predicted_slack) {
   if (front.empty()) throw Error("search", "no subnet was scored");
   int n = 1;
@@ -187,12 +187,12 @@ MeasuredPick pick_measured(const std::vector<Candidate>& front, double predicted
     const int mid = (fits + fails) / 2;
     measured[mid] = measure(front[mid]);
     result.timed.emplace_back(front[mid].key, measured[mid]);
-    (measured[mid] <= measured_budget_ms ? fits : fails) = mid;
+    (measured[mid] <= measured_budget ? fits : fails) = mid;
   }
   result.fits = fits >= 0;
   const int chosen = std::max(fits, 0);
   result.pick = front[chosen];
-  result.measured_ms = measured[chosen];
+  result.measured = measured[chosen];
   return result;
 }
 

@@ -68,16 +68,17 @@ const Candidate& pick_within(const std::vector<Candidate>& front, double budget_
 // The pick checked by measurement. A latency table errs by several percent on a subnet, enough to
 // carry the pick over its budget, so the front (fastest first, quality rising with latency) is
 // bisected by measured latency among the subnets predicted within `predicted_slack` of the
-// budget: the best that measures within `measured_budget_ms`, about log2(front) timings; the
-// fastest when none does.
+// budget: the best whose `measure` is within `measured_budget`, about log2(front) timings; the
+// fastest when none is. `measure` and `measured_budget` share a unit: ms, or a fraction of a
+// reference network's latency timed alongside (pipeline/search_stage.cpp).
 struct MeasuredPick {
   Candidate pick;
-  double measured_ms = 0;
+  double measured = 0;  // the pick's measure
   bool fits = false;
-  std::vector<std::pair<std::string, double>> timed;  // (key, measured ms), in the order timed
+  std::vector<std::pair<std::string, double>> timed;  // (key, measure), in the order timed
 };
 MeasuredPick pick_measured(const std::vector<Candidate>& front, double predicted_budget_ms,
-                           double measured_budget_ms, const std::function<double(const Candidate&)>& measure,
+                           double measured_budget, const std::function<double(const Candidate&)>& measure,
                            double predicted_slack = 1.25);
 
 // The front's hypervolume against (latency_ref, quality_ref) (core/pareto.h).

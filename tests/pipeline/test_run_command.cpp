@@ -130,6 +130,11 @@ TEST(RunCommand, RunsEveryStageThenCachesThem) {
                                  "heldout/1_heldout/data/manifest.yaml", "heldout/1_heldout/eval/results.json",
                                  "report/report.md", "verdict.txt", "results.json", "log.txt"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
+  // The pick is timed against the backbone, what the verdict's latency check divides by; the
+  // controls against the pick, each cut kept for a resumed run.
+  EXPECT_EQ(read_json(out / "search" / "pick.json")["reference"], "PAN x2");
+  for (const std::string kind : {"magnitude", "uniform"})
+    EXPECT_GT(read_json(out / "controls" / ("cut_" + kind + ".json"))["latency_fraction"].get<double>(), 0) << kind;
 
   // The report holds every model of the pipeline; the verdict judges them.
   const std::string report = slurp(out / "report" / "report.md");

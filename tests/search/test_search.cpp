@@ -190,7 +190,7 @@ TEST(SearchLoop, EvolutionScoresEverySubnetOnceAndBuildsAFront) {
   EXPECT_TRUE(m.fits);
   EXPECT_EQ(m.pick.key, r.front[best_fitting].key);
   EXPECT_NE(m.pick.key, pick_within(r.front, widest).key);
-  EXPECT_DOUBLE_EQ(m.measured_ms, 1.2 * m.pick.score.latency_ms);
+  EXPECT_DOUBLE_EQ(m.measured, 1.2 * m.pick.score.latency_ms);
   EXPECT_EQ(static_cast<int>(m.timed.size()), timings);
   EXPECT_LE(timings, static_cast<int>(std::ceil(std::log2(r.front.size() + 1.0))));
   // Nothing fits: the fastest subnet, flagged.
