@@ -4,24 +4,19 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("cgsr-test-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 size_t file_count(const fs::path& dir) {
   return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 }  // namespace
 
 TEST(AtomicFile, WritesAndReplaces) {
-  const auto dir = fresh_dir("atomic");
+  const auto dir = test::scratch_dir("atomic");
   write_file_atomic(dir / "a.txt", "first");
   write_file_atomic(dir / "a.txt", "second");
   EXPECT_EQ(read_file(dir / "a.txt"), "second");
@@ -29,7 +24,7 @@ TEST(AtomicFile, WritesAndReplaces) {
 }
 
 TEST(AtomicFile, AFailingWriterKeepsTheOldFile) {
-  const auto dir = fresh_dir("atomic-fail");
+  const auto dir = test::scratch_dir("atomic-fail");
   write_file_atomic(dir / "a.txt", "old");
   EXPECT_THROW(write_atomic_with(dir / "a.txt",
                                  [](const fs::path& tmp) {
@@ -52,7 +47,7 @@ TEST(AtomicFile, MissingFileNamesIt) {
 
 // Renaming over a directory fails; the message once read "Success" (the clean-up's error code).
 TEST(AtomicFile, ADirectoryInTheWayIsNamedNotSuccess) {
-  const auto dir = fresh_dir("atomic-dir");
+  const auto dir = test::scratch_dir("atomic-dir");
   fs::create_directories(dir / "model.onnx" / "inside");
   try {
     write_file_atomic(dir / "model.onnx", "bytes");
@@ -70,7 +65,7 @@ TEST(AtomicFile, ADirectoryInTheWayIsNamedNotSuccess) {
 // A full disk is a user error naming the file and the fix; the old file stays, no temporary is
 // left, and other files are still written (CGSR_FAULT_NO_SPACE counts per file name).
 TEST(AtomicFile, AFullDiskKeepsTheOldFileAndSaysWhatToDo) {
-  const auto dir = fresh_dir("atomic-no-space");
+  const auto dir = test::scratch_dir("atomic-no-space");
   ::setenv("CGSR_FAULT_NO_SPACE", "model.cgsr@1", 1);
   write_file_atomic(dir / "model.cgsr", "good");
   try {

@@ -11,6 +11,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/yaml_json.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 using namespace cgsr::config;
@@ -396,7 +397,7 @@ TEST(Config, ConfigsAreBoundedBeforeTheyAreParsed) {
   e = error_of(laughs);
   EXPECT_NE(e.find("more than 1000000 values (counting each use of an alias)"), std::string::npos) << e;
   // A file too large is refused before it is read.
-  const auto file = std::filesystem::temp_directory_path() / ("cgsr-big-config-" + std::to_string(::getpid()) + ".yaml");
+  const auto file = test::scratch_dir("big-config") / "big.yaml";
   { std::ofstream(file) << big; }
   try {
     Document::load_file(file);

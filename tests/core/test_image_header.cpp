@@ -11,18 +11,14 @@
 #include "core/error.h"
 #include "core/image_header.h"
 #include "core/image_io.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 namespace fs = std::filesystem;
 
 namespace {
 fs::path header_dir() {
-  static const fs::path dir = [] {
-    auto d = fs::temp_directory_path() / ("cgsr-test-image-header-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = test::scratch_dir("image-header");
   return dir;
 }
 

@@ -9,18 +9,14 @@
 #include "core/color.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 namespace fs = std::filesystem;
 
 namespace {
 fs::path temp_dir() {
-  static const fs::path dir = [] {
-    auto d = fs::temp_directory_path() / ("cgsr-test-image-" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = test::scratch_dir("image");
   return dir;
 }
 

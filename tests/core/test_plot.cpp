@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/plot.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 namespace fs = std::filesystem;
@@ -32,8 +33,7 @@ int height_of(const fs::path& png) {
 }  // namespace
 
 TEST(BarChart, LongCategoryNamesGetTheRoomTheyNeed) {
-  const fs::path dir = fs::temp_directory_path() / "cgsr-test-plot";
-  fs::create_directories(dir);
+  const fs::path dir = test::scratch_dir("plot");
   write_bar_chart(dir / "short.png", chart("hr_fuse"));
   write_bar_chart(dir / "long.png", chart("hr_unshuffle+hr_fuse - normal_angle (a long variant name)"));
   // The plot area is the same; the strip under it grows with the longest name.
@@ -44,7 +44,7 @@ TEST(BarChart, LongCategoryNamesGetTheRoomTheyNeed) {
 TEST(BarChart, ASeriesMustHaveOneValuePerCategory) {
   BarChart c = chart("hr_fuse");
   c.series[0].values.pop_back();
-  EXPECT_THROW(write_bar_chart(fs::temp_directory_path() / "cgsr-test-plot-bad.png", c), Error);
+  EXPECT_THROW(write_bar_chart(test::scratch_dir("plot-bad") / "bad.png", c), Error);
 }
 
 namespace {
@@ -130,7 +130,7 @@ TEST(BarChart, LabelsNeverOverlapOrLeaveTheCanvas) {
 }
 
 TEST(Canvas, SavesPngSvgAndPdfByExtension) {
-  const fs::path dir = fs::temp_directory_path() / "cgsr-test-canvas";
+  const fs::path dir = test::scratch_dir("canvas");
   Canvas c(120, 80);
   c.text({10, 40}, "PSNR 25.4 dB", {});
   c.marker({100, 40}, Marker::Diamond, 5, {220, 40, 40}, true);

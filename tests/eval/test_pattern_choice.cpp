@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "eval/pattern_choice.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 
@@ -37,8 +38,7 @@ TEST(PatternChoice, CountsThePatternsEachFrameChose) {
   EXPECT_NE(md.find("| 5 | 1.00 | 2 | 50 | 35.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("(choice.png)"), std::string::npos);
 
-  const auto dir = std::filesystem::temp_directory_path() / "cgsr_test_pattern_choice";
-  std::filesystem::create_directories(dir);
+  const auto dir = test::scratch_dir("pattern-choice");
   write_scatter_plot(dir / "choice.png", pattern_choice_plot(r.name, *choices));
   EXPECT_GT(read_image(dir / "choice.png").numel(), 0);
   std::filesystem::remove_all(dir);

@@ -12,6 +12,7 @@
 #include "eval/frame_plot.h"
 #include "eval/report.h"
 #include "tests/support/svg_paths.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 
@@ -105,7 +106,7 @@ TEST(Report, EdgeColumnsOnlyWhenSomeRowHasThem) {
 }
 
 TEST(Report, PlotIsAPngAndAnSvg) {
-  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-plot";
+  const auto dir = test::scratch_dir("report-plot");
   auto pan = row("pan", 33, 12.0, 261403);
   pan.psnr_edge = 28;
   ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), pan, row("fsr", 31, std::nullopt)}, ""};
@@ -222,7 +223,7 @@ TEST(Report, InfinitePsnrPerFrameStaysOnThePlot) {
   EXPECT_TRUE(std::any_of(plot->notes.begin(), plot->notes.end(),
                           [](const std::string& n) { return n.find("+inf") != std::string::npos; }));
   const auto canvas = draw_line_plot(*plot);
-  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-frame-plot";
+  const auto dir = test::scratch_dir("report-frame-plot");
   canvas->save(dir / "frames.svg");
   const auto paths = test::svg_paths(read_file(dir / "frames.svg"));
   ASSERT_FALSE(paths.empty());
@@ -267,8 +268,7 @@ TEST(Report, InfinitePsnrPerFrameStaysOnThePlot) {
 // The report draws PSNR per frame under each table with two evaluated frames, records it in its
 // results and shows it on its page.
 TEST(Report, WriteReportDrawsPsnrPerFrame) {
-  const auto dir = std::filesystem::temp_directory_path() / "cgsr-report-frames";
-  std::filesystem::remove_all(dir);
+  const auto dir = test::scratch_dir("report-frames");
   auto single = scored("bicubic", {3}, {{"yard", 0}});
   single.dataset = "yard";
   {

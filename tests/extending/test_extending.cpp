@@ -58,12 +58,7 @@ ArchSpec example_spec(int blocks, const std::string& extra = "") {
   return spec_from_yaml("backbone: example\nscale: 2\nblocks: " + std::to_string(blocks) + "\n" + extra, "example.yaml");
 }
 
-fs::path fresh_dir(const std::string& name) {
-  const auto dir = fs::temp_directory_path() / ("cgsr-extending-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return test::scratch_dir("extending-" + name); }
 
 // Widths in steps of 4 down to a quarter, at least `min_blocks` blocks.
 ElasticOptions elastic_options(int min_blocks) {

@@ -6,6 +6,7 @@
 #include "models/arch_spec.h"
 #include "models/backbone_registry.h"
 #include "tests/models/model_cases.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 using namespace cgsr::test;
@@ -51,8 +52,7 @@ TEST(ArchSpec, YamlRoundTripForEveryBackbone) {
 }
 
 TEST(ArchSpec, FilesRoundTripAtomically) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cgsr-spec-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const auto dir = test::scratch_dir("spec");
   ArchSpec s = with_rit(default_spec("edsr", 4));
   s.blocks = 5;
   s.widths = GroupWidths();

@@ -69,8 +69,7 @@ TEST(MemoryLayout, ParametersChangeLayoutInPlaceAndKeepValues) {
 namespace {
 // An empty machine cache of its own (CGSR_CACHE_DIR) and a process that remembers nothing yet.
 std::filesystem::path fresh_layout_cache(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cgsr-layouts-" + name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const auto dir = test::scratch_dir("layouts-" + name);
   ::setenv("CGSR_CACHE_DIR", dir.c_str(), 1);
   forget_measured_layouts();
   return dir;

@@ -9,6 +9,7 @@
 #include "models/model_file.h"
 #include "pipeline/search_stage.h"
 #include "pipeline/train_stage.h"
+#include "tests/support/scratch_dir.h"
 
 using namespace cgsr;
 
@@ -46,7 +47,7 @@ TEST(StageConfigs, TheElasticStageTakesItsElasticKeysAtItsTop) {
 // elastic network computes the model's function (its channels only reordered), with it another.
 TEST(StageConfigs, AnElasticStageFromScratchStartsFromFreshWeights) {
   torch::manual_seed(5);
-  const auto file = std::filesystem::temp_directory_path() / ("cgsr_from_scratch_" + std::to_string(::getpid()) + ".cgsr");
+  const auto file = test::scratch_dir("stage-configs") / "trained.cgsr";
   SRNetwork trained(resolve_spec(default_spec("pan", 2)));
   save_model(file, *trained);
   TrainOptions o = parse<TrainOptions>("data: d\nmodel: " + file.string() + "\n", elastic_stage_schema());

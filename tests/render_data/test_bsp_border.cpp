@@ -263,7 +263,7 @@ BspBorderImage sample_image() {
 }
 
 TEST(BspBorderFile, RoundTrips) {
-  const auto dir = test::temp_dir("bsp_round_trip");
+  const auto dir = test::scratch_dir("bsp_round_trip");
   const BspBorderImage image = sample_image();
   const auto path = bsp_border_file(dir, {8, 6}, 3);
   EXPECT_EQ(path, dir / "8x6" / "bsp_border" / "000003.bsp");
@@ -339,7 +339,7 @@ TEST(BspBorderFile, RefusesCorruptFilesNamingTheProblem) {
   bad[24] = static_cast<char>(0xff);  // count: far more records than the file holds
   m = problem_with(bad);
   EXPECT_TRUE(has(m, "count")) << m;
-  const auto dir = test::temp_dir("bsp_missing");
+  const auto dir = test::scratch_dir("bsp_missing");
   m = "";
   try {
     read_bsp_border_file(dir / "none.bsp", 5, {8, 6});
@@ -376,7 +376,7 @@ TEST(BspBorderRender, RenderWithoutTheOptionKeepsItsEarlierFingerprint) {
   config::Document doc = config::Document::load_file(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
   doc.apply_override("frames=3", "test");
   const TinyConfig o = config::parse_document(doc, schema);
-  const auto dir = test::temp_dir("bsp_seed_manifest");
+  const auto dir = test::scratch_dir("bsp_seed_manifest");
   std::filesystem::copy_file(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/manifest/tiny_manifest.yaml", dir / "manifest.yaml");
   const DatasetManifest seed_manifest = read_manifest(dir);
   EXPECT_EQ(render_fingerprint(o, 0), seed_manifest.fingerprint);
@@ -393,7 +393,7 @@ TEST(BspBorderRender, OffByDefaultKeepsFingerprintAndFiles) {
   EXPECT_EQ(render_fingerprint(off, 1), render_fingerprint(tiny_job(0), 1));
   EXPECT_NE(render_fingerprint(on, 1), render_fingerprint(off, 1));
 
-  const auto dir = test::temp_dir("bsp_render");
+  const auto dir = test::scratch_dir("bsp_render");
   const RenderJobResult plain = run_render_job(off, 1, dir / "plain");
   EXPECT_FALSE(std::filesystem::exists(dir / "plain" / "64x48" / "bsp_border"));
   EXPECT_EQ(read_file(dir / "plain" / "manifest.yaml").find("bsp_border"), std::string::npos);

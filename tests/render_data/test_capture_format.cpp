@@ -154,7 +154,7 @@ TEST(CaptureFormat, QuantisedDepthStaircasesAreNotEdges) {
 // --- a cgsr-rendered sequence written as a game capture ---------------------------------------
 
 TEST(CaptureFormat, RenderedSequenceAsAGameCaptureLoadsBack) {
-  const fs::path dir = test::temp_dir("capture_roundtrip");
+  const fs::path dir = test::scratch_dir("capture_roundtrip");
   const auto r = test::run_cgsr("render --config " + std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml --out " +
                                 (dir / "render").string() + " --threads 1 --set 'resolutions=[160x120, 320x240]' --set frames=6");
   ASSERT_EQ(r.exit_code, 0) << r.err;

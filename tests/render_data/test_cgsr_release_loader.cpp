@@ -43,7 +43,7 @@ void write_release_frame(const fs::path& dir, int f, int W, bool grid) {
 }
 
 fs::path write_release(const std::string& name, int frames, bool grid = true) {
-  const fs::path root = test::temp_dir(name) / "doom3";
+  const fs::path root = test::scratch_dir(name) / "doom3";
   for (int W : {64, 128}) {
     fs::create_directories(root / std::to_string(W));
     for (int f = 0; f < frames; ++f) write_release_frame(root / std::to_string(W), f, W, grid);

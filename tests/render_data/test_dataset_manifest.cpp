@@ -13,7 +13,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(DatasetManifest, RoundTrip) {
-  const fs::path dir = test::temp_dir("manifest_round_trip");
+  const fs::path dir = test::scratch_dir("manifest_round_trip");
   DatasetManifest m;
   m.name = "room";
   m.complete = true;
@@ -74,7 +74,7 @@ TEST(DatasetManifest, SplitProportionsAndUniformTestFrames) {
 }
 
 TEST(DatasetManifest, MalformedManifestsNameFileAndKey) {
-  const fs::path dir = test::temp_dir("manifest_bad");
+  const fs::path dir = test::scratch_dir("manifest_bad");
   EXPECT_THROW(read_manifest(dir), Error);
   std::ofstream(dir / "manifest.yaml") << "format: cgsr-dataset\nversion: 1\nname: x\ncomplete: true\nfingerprint: a\n"
                                           "frames: 4\nresolutions: [320x240, 500x480]\nnear: 0.1\nfar: 0.05\n"

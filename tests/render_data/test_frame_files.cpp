@@ -27,7 +27,7 @@ void expect_error(const std::function<void()>& f, const std::vector<std::string>
 }
 
 TEST(FrameFiles, ExtremeDepthsAndSkyRoundTripExactly) {
-  const fs::path dir = test::temp_dir("frame_files_extreme");
+  const fs::path dir = test::scratch_dir("frame_files_extreme");
   GBuffer g = test::flat_gbuffer(8, 6);
   g.depth[0][0][0] = 1e-3f;
   g.depth[0][0][1] = 1e6f;
@@ -58,7 +58,7 @@ TEST(FrameFiles, ExtremeDepthsAndSkyRoundTripExactly) {
 }
 
 TEST(FrameFiles, BadFilesNameTheFileAndFrame) {
-  const fs::path dir = test::temp_dir("frame_files_bad");
+  const fs::path dir = test::scratch_dir("frame_files_bad");
   const Resolution r{8, 6};
   write_frame_files(dir, r, 4, test::flat_gbuffer(8, 6));
   const fs::path depth = frame_file(dir, r, FileKind::Depth, 4);

@@ -18,7 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path write_capture(const std::string& name, int frames) {
-  const fs::path root = test::temp_dir(name);
+  const fs::path root = test::scratch_dir(name);
   fs::create_directories(root / "lr");
   fs::create_directories(root / "hr");
   for (int f = 0; f < frames; ++f) {

@@ -256,7 +256,7 @@ TEST(HistoryChannel, IsDeterministicAndAClearErrorWithoutMotion) {
   EXPECT_EQ(std::find(defaults.begin(), defaults.end(), RenderChannel::History), defaults.end());
   EXPECT_TRUE(open_for_channels(jittered_data(), {RenderChannel::History}).frame(2, 1)->has(RenderChannel::History));
 
-  const fs::path root = test::temp_dir("history_no_motion");
+  const fs::path root = test::scratch_dir("history_no_motion");
   fs::create_directories(root / "lr");
   fs::create_directories(root / "hr");
   for (int f = 0; f < 2; ++f) {

@@ -122,7 +122,7 @@ TEST(HrSamples, OnlyPixelsAtGeometryEdgesChange) {
 // same, the targets' colour is render_color's. hr_samples 1 is the render without the key: same
 // fingerprint, no manifest key, the same bytes as render().
 TEST(HrSamples, SupersamplingChangesOnlyTheTargetsColour) {
-  const fs::path root = test::temp_dir("hr_samples_render");
+  const fs::path root = test::scratch_dir("hr_samples_render");
   RenderJobOptions one = hr_tiny_job(2, 1), four = hr_tiny_job(2, 4);
   one.name = "one";
   four.name = "four";
@@ -193,7 +193,7 @@ TEST(HrSamples, SupersamplingChangesOnlyTheTargetsColour) {
 }
 
 TEST(HrSamples, ManifestRoundTripAndMalformedValuesNameTheKey) {
-  const fs::path dir = test::temp_dir("hr_samples_manifest");
+  const fs::path dir = test::scratch_dir("hr_samples_manifest");
   DatasetManifest m;
   m.name = "aa";
   m.fingerprint = "0123456789abcdef";
@@ -219,7 +219,7 @@ TEST(HrSamples, ManifestRoundTripAndMalformedValuesNameTheKey) {
 TEST(HrSamples, BadValuesAreErrorsNamingTheKey) {
   for (int bad : {2, 0, 25}) {
     try {
-      run_render_job(hr_tiny_job(1, bad), 1, test::temp_dir("hr_samples_bad"));
+      run_render_job(hr_tiny_job(1, bad), 1, test::scratch_dir("hr_samples_bad"));
       ADD_FAILURE() << bad;
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find("hr_samples: is " + std::to_string(bad) + ", must be a square"),
@@ -230,13 +230,13 @@ TEST(HrSamples, BadValuesAreErrorsNamingTheKey) {
   RenderJobOptions single = hr_tiny_job(1, 4);
   single.resolutions = {"64x48"};
   try {
-    run_render_job(single, 1, test::temp_dir("hr_samples_single"));
+    run_render_job(single, 1, test::scratch_dir("hr_samples_single"));
     ADD_FAILURE() << "supersampled a render with no target resolution";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("there is only 64x48"), std::string::npos) << e.what();
   }
   // The config: the key is checked before anything renders.
-  const fs::path out = test::temp_dir("hr_samples_cli") / "set";
+  const fs::path out = test::scratch_dir("hr_samples_cli") / "set";
   const test::CliResult r = test::run_cgsr("render --config " + tiny_scene_config() + " --set hr_samples=3 --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.all();
   EXPECT_NE(r.all().find("hr_samples"), std::string::npos) << r.all();

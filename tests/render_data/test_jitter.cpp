@@ -134,7 +134,7 @@ TEST(Jitter, MotionExcludesTheJitter) {
 }
 
 TEST(Jitter, OffsetsRoundTripThroughTheManifest) {
-  const fs::path dir = test::temp_dir("jitter_manifest");
+  const fs::path dir = test::scratch_dir("jitter_manifest");
   DatasetManifest m;
   m.name = "j";
   m.fingerprint = "0123456789abcdef";
@@ -163,7 +163,7 @@ TEST(Jitter, OffsetsRoundTripThroughTheManifest) {
 }
 
 TEST(Jitter, MalformedOffsetsNameTheManifestAndKey) {
-  const fs::path dir = test::temp_dir("jitter_bad");
+  const fs::path dir = test::scratch_dir("jitter_bad");
   test::expect_manifest_errors(dir, {
       {"jitter: {resolution: 32x24, sequence: halton, phases: 8, offsets: [[0, 0.1]]}", "has 1 offsets for 2 frames"},
       {"jitter: {resolution: 32x24, sequence: halton, phases: 8, offsets: [[0, 0.1], [0.5, 0]]}",
@@ -179,7 +179,7 @@ TEST(Jitter, MalformedOffsetsNameTheManifestAndKey) {
 // to the loader, the larger ones (the ground truth) none; the fingerprint tells it apart, and a
 // render with jitter off has the fingerprint it had before the option.
 TEST(Jitter, ARenderedDataSetRecordsTheOffsetsAndTheLoaderReadsThem) {
-  const fs::path root = test::temp_dir("jitter_render");
+  const fs::path root = test::scratch_dir("jitter_render");
   const auto doc = config::Document::load_file(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml");
   RenderJobOptions job;
   job.frames = 3;

@@ -55,7 +55,7 @@ struct Renders {
 const Renders& renders() {
   static const Renders r = [] {
     Renders x;
-    x.root = test::temp_dir("multi_scene");
+    x.root = test::scratch_dir("multi_scene");
     x.scene_b = second_scene_config(x.root);
     x.set = x.root / "set";
     const CliResult set = run_cgsr("render --scene " + tiny_config() + " --scene " + x.scene_b.string() + " --out " + x.set.string());

@@ -45,7 +45,7 @@ GBuffer synthetic(int frame, const Resolution& r, int lr_width) {
 
 const fs::path& synthetic_dataset() {
   static const fs::path dir = [] {
-    const fs::path d = test::temp_dir("sampler_data");
+    const fs::path d = test::scratch_dir("sampler_data");
     test::write_test_dataset(d, 10, {{40, 30}, {80, 60}}, [](int f, const Resolution& r) { return synthetic(f, r, 40); });
     return d;
   }();

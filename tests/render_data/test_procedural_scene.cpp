@@ -201,7 +201,7 @@ TEST(ProceduralVariety, SameSeedSameLevelOtherSeedsOtherLevels) {
 }
 
 TEST(ProceduralVariety, SameSeedRendersBitIdenticalFrames) {
-  const fs::path root = test::temp_dir("variety_frames");
+  const fs::path root = test::scratch_dir("variety_frames");
   std::vector<std::string> colour;
   for (const char* run : {"a", "b"}) {
     RenderJobOptions job;

@@ -20,7 +20,7 @@ using test::run_cgsr;
 
 // fuzz/corpus's bomb seed without its file-kind byte.
 fs::path bomb_png() {
-  const fs::path path = test::temp_dir("bomb") / "bomb.png";
+  const fs::path path = test::scratch_dir("bomb") / "bomb.png";
   std::ifstream in(std::string(CGSR_SOURCE_DIR) + "/fuzz/corpus/frame_files/color_bomb_20000x20000.bin", std::ios::binary);
   in.get();
   std::ofstream(path, std::ios::binary) << in.rdbuf();
@@ -30,7 +30,7 @@ fs::path bomb_png() {
 std::string tiny_config() { return std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml"; }
 
 TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
-  const fs::path out = test::temp_dir("cli_render") / "tiny";
+  const fs::path out = test::scratch_dir("cli_render") / "tiny";
   const CliResult render = run_cgsr("render --config " + tiny_config() + " --out " + out.string());
   ASSERT_EQ(render.exit_code, 0) << render.all();
   EXPECT_NE(render.all().find("per frame"), std::string::npos) << render.all();
@@ -86,7 +86,7 @@ TEST(RenderCli, RenderThenCheckThenResumeThenDetectDamage) {
 // results.json cannot be written (a full disk, injected) exits 2 with the manifest incomplete,
 // and the rerun finishes it from the frames on disk.
 TEST(RenderCli, TheManifestIsMarkedCompleteOnlyAfterTheResults) {
-  const fs::path out = test::temp_dir("cli_render_results") / "tiny";
+  const fs::path out = test::scratch_dir("cli_render_results") / "tiny";
   const std::string args = "render --config " + tiny_config() + " --set frames=2 --out " + out.string();
   ::setenv("CGSR_FAULT_NO_SPACE", "results.json", 1);
   const CliResult full = run_cgsr(args);
@@ -104,7 +104,7 @@ TEST(RenderCli, TheManifestIsMarkedCompleteOnlyAfterTheResults) {
 }
 
 TEST(RenderCli, PreviewWritesAMontage) {
-  const fs::path out = test::temp_dir("cli_preview") / "tiny";
+  const fs::path out = test::scratch_dir("cli_preview") / "tiny";
   ASSERT_EQ(run_cgsr("render --config " + tiny_config() + " --set frames=2 --out " + out.string()).exit_code, 0);
   const fs::path png = out.parent_path() / "preview.png";
   const CliResult preview = run_cgsr("data preview " + out.string() + " --frame 1 --image " + png.string());
@@ -116,10 +116,10 @@ TEST(RenderCli, PreviewWritesAMontage) {
 
 TEST(RenderCli, BadConfigsAreUserErrors) {
   const CliResult scale = run_cgsr("render --config " + tiny_config() + " --set resolutions=[64x48,100x75] --out " +
-                         (test::temp_dir("cli_bad") / "x").string());
+                         (test::scratch_dir("cli_bad") / "x").string());
   EXPECT_EQ(scale.exit_code, 2) << scale.all();
   EXPECT_NE(scale.all().find("not an integer scale"), std::string::npos) << scale.all();
-  const CliResult missing = run_cgsr("data check " + (test::temp_dir("cli_bad2") / "nothing").string());
+  const CliResult missing = run_cgsr("data check " + (test::scratch_dir("cli_bad2") / "nothing").string());
   EXPECT_EQ(missing.exit_code, 2) << missing.all();
 }
 

@@ -19,6 +19,7 @@
 #include "render_data/renderer.h"
 #include "render_data/scene.h"
 #include "render_data/scene_source.h"
+#include "tests/support/scratch_dir.h"
 
 namespace cgsr::test {
 
@@ -62,15 +63,6 @@ inline void add_quad(Scene& s, Vec3 centre, Vec3 u, Vec3 v, int object_id) {
   s.meshes.push_back(m);
 }
 
-// A fresh directory for one test; the process id keeps parallel test processes (ctest runs each
-// case on its own) and other builds' runs of this suite apart.
-inline std::filesystem::path temp_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("cgsr_test_render_data_" + std::to_string(::getpid()) + "_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 // A render config as `cgsr render` reads it (its run settings included).
 struct SceneConfig : RenderJobOptions {

@@ -34,8 +34,7 @@ ArchSpec elastic_pan(int blocks = 4) {
 }
 
 std::filesystem::path temp_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cgsr_test_search_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  static const auto dir = test::scratch_dir("test-search");
   const auto path = dir / name;
   std::filesystem::remove(path);
   return path;

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/scratch_dir.h"
+
 namespace cgsr::test {
 
 struct CliResult {
@@ -28,14 +30,6 @@ inline std::string slurp(const std::filesystem::path& path) {
 }
 
 inline nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(slurp(path)); }
-
-// A fresh directory under the system temp dir, unique per process and name.
-inline std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cgsr-" + name + "-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 // `args` is appended to the binary path as shell words (quote them yourself where needed).
 inline CliResult run_cgsr(const std::string& args) {

@@ -454,8 +454,7 @@ TEST(RunIdentity, TheDataSetFingerprintTellsDataSetsApart) {
 // ends at other weights than the float32 fine-tuning, the calibration it used is in the model
 // file, and an elastic network refuses it.
 TEST(TrainCommand, QuantizationAwareFineTuningTrainsThroughSimulatedInt8) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cgsr_test_qat_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const auto dir = test::scratch_dir("qat");
   const std::string common = " --data " + tiny_data().string() +
                              " --steps 2 --threads 1 --set seed=4 --set schedule.batch_size=2 --set schedule.patch_size=16"
                              " --set schedule.val_frames=1";
