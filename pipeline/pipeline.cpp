@@ -346,8 +346,10 @@ class Pipeline {
     const std::string budget =
         search_.pick.latency_ms > 0
             ? fmt::format("{:g} ms", search_.pick.latency_ms)
-            : fmt::format("{:g} of {}'s latency", search_.pick.latency_fraction,
-                          search_.pick.reference.empty() ? "the full network" : search_.pick.reference);
+            : fmt::format("{:g} of the latency of {}", search_.pick.latency_fraction,
+                          search_.pick.reference.empty()                           ? "the full network"
+                          : search_.pick.reference == model_file("train").string() ? "the train stage's network"
+                                                                                   : search_.pick.reference);
     line("search", fmt::format("{}, population {} over {} generations{}; the pick within {}, fine-tuned {}",
                                search_.search.strategy.type, search_.search.population, search_.search.generations,
                                search_.baseline.empty() ? "" : ", and " + search_.baseline + " search as many", budget,
@@ -410,7 +412,8 @@ class Pipeline {
     search_filled["model"] = model_file("elastic").string();
     search_ = parse_stage(options_.search, search_command_schema(), search_filled, "search");
     // The pick's budget is a fraction of what the verdict's latency check divides by: the backbone.
-    if (search_.pick.reference.empty() && search_.pick.measure_runs > 0) search_.pick.reference = model_file("train").string();
+    if (search_.pick.reference.empty() && search_.pick.measure_runs > 0)
+      search_.pick.reference = model_file("train").string();
     // From scratch: the pick's architecture (the search writes it) with the train stage's schedule.
     scratch_ = backbone_;
     scratch_.model = (stages_.dir("search") / "pick_spec.yaml").string();
