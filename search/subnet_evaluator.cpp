@@ -106,17 +106,12 @@ SubnetScore InferenceEvaluator::evaluate(const SubnetConfig& subnet) {
     return t.narrow(2, margin_hr_, n).narrow(3, margin_hr_, n);
   };
   const auto inputs = network_inputs(g, scored_.lr_color, scored_.info);
-  torch::Tensor out;
-  if (subnet.precision == Precision::Fp32) {
-    out = graph::run(g, inputs).front().second;
-  } else {
-    FusedGraph::Options o;
-    o.precision = subnet.precision;
-    if (subnet.precision == Precision::Int8)
-      o.calibration = calibrate(g, {network_inputs(g, calibration_.lr_color, calibration_.info)},
-                                CalibrationMethod::Percentile);
-    out = FusedGraph(g, o).run(inputs).front().second;
-  }
+  FusedGraph::Options o;
+  o.precision = subnet.precision;
+  if (subnet.precision == Precision::Int8)
+    o.calibration = calibrate(g, {network_inputs(g, calibration_.lr_color, calibration_.info)},
+                              CalibrationMethod::Percentile);
+  const torch::Tensor out = FusedGraph(g, o).run(inputs).front().second;
   const torch::Tensor sr = cut(out.clamp(0, 1));
   const torch::Tensor err = (sr - cut(scored_.hr_color)).square();
   const double mse = err.mean().item<double>();
