@@ -180,8 +180,6 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   check_output_option(spec.rit.bsp_composite, "bsp_composite", RenderChannel::Bsp, "composites the output with");
   check_output_option(spec.rit.history_blend, "history_blend", RenderChannel::History, "blends the output with");
   check_output_option(spec.rit.skip_at_jitter, "skip_at_jitter", RenderChannel::Jitter, "takes the image skip at");
-  if (spec.rit.history_reject && !spec.rit.history_blend)
-    problems.push_back({"rit.history_reject", "rejects samples of the history blend; set rit.history_blend"});
   if (spec.rit.skip_at_jitter && (!info.has_image_skip || spec.image_skip != ImageSkip::Bilinear))
     problems.push_back({"rit.skip_at_jitter", info.has_image_skip
                                                   ? "moves a bilinear image skip; image_skip is " + enum_name(spec.image_skip)
@@ -266,9 +264,6 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("history_blend", &RitSpec::history_blend,
             "blend the output with the history channel's samples by a learned weight where there is one");
   rit.omit_when("history_blend", [](const RitSpec& r) { return !r.history_blend; });
-  rit.field("history_reject", &RitSpec::history_reject,
-            "the blend's weight also reads |sample - output|, so it can reject samples that disagree");
-  rit.omit_when("history_reject", [](const RitSpec& r) { return !r.history_reject; });
   rit.field("skip_at_jitter", &RitSpec::skip_at_jitter,
             "interpolate the bilinear image skip at the jitter channel's offsets (the unjittered output grid)");
   rit.omit_when("skip_at_jitter", [](const RitSpec& r) { return !r.skip_at_jitter; });
@@ -338,7 +333,6 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
          " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") +
-         (r.history_reject ? ", reject" : "") +
          (r.skip_at_jitter ? ", skip at jitter" : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";

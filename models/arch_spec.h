@@ -26,7 +26,6 @@
 //                            #   the network's elsewhere (needs bsp among channels, an HR source)
 //     history_blend: false   # the output blended with the history channel's samples by a learned
 //                            #   weight (needs history among channels, an HR source)
-//     history_reject: false  # the blend's weight also sees |sample - output| (needs history_blend)
 //     skip_at_jitter: false  # PAN's bilinear image skip taken at the jitter channel's offsets
 //                            #   (needs jitter among channels, an HR source)
 //   geometry:                # training-only head predicting the HR rendering information
@@ -116,10 +115,6 @@ struct RitSpec {
   // out = net + w * (history_rgb - net), w = sigmoid(conv(net, info)) * recency. Where no frame
   // left a sample (recency 0) the output is the network's; elsewhere it learns how far to trust one.
   bool history_blend = false;
-  // The blend's weight also reads how far each sample is from the network's image, as the two
-  // halves relu(d) and relu(-d) of d = history_rgb - net: a conv over them can grow with |d| and
-  // reject a sample that disagrees with the image (what TAA's colour clamp does by hand).
-  bool history_reject = false;
   // PAN's bilinear image skip interpolated at the frame's jitter (the jitter channel, rit.h): the
   // output pixel's own position in a jittered LR frame, where the unjittered skip reads it up to
   // half an LR pixel off.
@@ -137,8 +132,7 @@ struct RitSpec {
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
            hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding &&
-           bsp_composite == o.bsp_composite && history_blend == o.history_blend &&
-           history_reject == o.history_reject && skip_at_jitter == o.skip_at_jitter;
+           bsp_composite == o.bsp_composite && history_blend == o.history_blend && skip_at_jitter == o.skip_at_jitter;
   }
 };
 

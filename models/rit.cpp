@@ -78,10 +78,8 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::History);
     history_color_ = selection(c, offset, 1);
     history_recency_ = selection(c, offset + 3, 0);
-    reject_ = rit.history_reject;
-    const int64_t inputs = 3 + c + (rit.history_reject ? 6 : 0);
-    ParameterBudget::charge_conv(inputs, 3, 3, 1, /*bias=*/true);
-    blend = register_module("blend", make_conv(inputs, 3, 3));
+    ParameterBudget::charge_conv(3 + c, 3, 3, 1, /*bias=*/true);
+    blend = register_module("blend", make_conv(3 + c, 3, 3));
     zero_conv(blend);
     torch::NoGradGuard no_grad;
     blend->bias.fill_(-4.0f);
@@ -161,30 +159,19 @@ int RitBlockImpl::describe_composite_bsp(graph::Builder& g, int image, int info)
 
 torch::Tensor RitBlockImpl::blend_history(const torch::Tensor& image, const torch::Tensor& info) {
   // The kernels and the operand order of describe_blend_history(), so both give the same bits.
+  const auto weight = torch::sigmoid(blend(torch::cat({image, info}, 1))) * torch::conv2d(info, history_recency_);
   const auto difference = torch::conv2d(info, history_color_) + graph::apply_affine(image, negate_scale_, negate_shift_);
-  std::vector<torch::Tensor> seen = {image, info};
-  if (reject_) {
-    seen.push_back(torch::relu(difference));
-    seen.push_back(torch::relu(graph::apply_affine(difference, negate_scale_, negate_shift_)));
-  }
-  const auto weight = torch::sigmoid(blend(torch::cat(seen, 1))) * torch::conv2d(info, history_recency_);
   return image + weight * difference;
 }
 
 int RitBlockImpl::describe_blend_history(graph::Builder& g, int image, int info) const {
   const auto rgb = g.value(image).layout;
-  const int history = g.conv("history_color", info, history_color_, {}, 0, rgb, /*trainable=*/false);
-  const int negated = g.affine("history_negate", image, negate_scale_, negate_shift_, /*trainable=*/false);
-  const int difference = g.add(history, negated);
-  std::vector<int> seen = {image, info};
-  if (reject_) {
-    seen.push_back(g.relu(difference));
-    seen.push_back(g.relu(g.affine("history_flip", difference, negate_scale_, negate_shift_, /*trainable=*/false)));
-  }
-  const int logit = describe_conv(g, "blend", blend, g.concat(seen), rgb);
+  const int logit = describe_conv(g, "blend", blend, g.concat({image, info}), rgb);
   const int recency = g.conv("history_recency", info, history_recency_, {}, 0, rgb, /*trainable=*/false);
   const int weight = g.mul(g.sigmoid(logit), recency);
-  return g.add(image, g.mul(weight, difference));
+  const int history = g.conv("history_color", info, history_color_, {}, 0, rgb, /*trainable=*/false);
+  const int negated = g.affine("history_negate", image, negate_scale_, negate_shift_, /*trainable=*/false);
+  return g.add(image, g.mul(weight, g.add(history, negated)));
 }
 
 torch::Tensor RitBlockImpl::skip_at_jitter(const torch::Tensor& image, const torch::Tensor& lr_color,

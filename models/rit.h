@@ -39,10 +39,7 @@
 // output there is the network's exactly; elsewhere the conv (layer "blend", 3 outputs, starting at
 // weight 0 and bias -4: w under 0.02) learns how far to trust a sample from its age, the
 // G-buffers and its disagreement with the network. A network given the samples as input learned
-// nothing from them (docs/results/history.md); here using one is a single weight away. With
-// rit.history_reject the conv also reads relu(d) and relu(-d), d = hist_rgb - net: a linear
-// function of the image cannot grow with |d|, so without them a sample far off the image is
-// trusted as much as a close one.
+// nothing from them (docs/results/history.md); here using one is a single weight away.
 //
 // rit.skip_at_jitter: PAN adds the LR image, bilinearly upsampled, to its output; in a jittered
 // frame that reads each output pixel up to half an LR pixel from where its content sits. The
@@ -126,7 +123,6 @@ class RitBlockImpl : public torch::nn::Module {
   // history_blend: constants, [3, C, 1, 1] selections of the history colour and of its recency
   // (broadcast to R, G, B); and -x as scale -1, shift 0.
   torch::Tensor history_color_, history_recency_, negate_scale_, negate_shift_;
-  bool reject_ = false;  // history_reject: the weight's conv also reads relu(d), relu(-d)
   // skip_at_jitter: a constant [2, C, 1, 1] selection of the jitter (x, y); the scale.
   torch::Tensor jitter_offsets_;
   int64_t scale_;

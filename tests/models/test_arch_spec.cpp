@@ -161,18 +161,6 @@ TEST(ArchSpec, ProgrammaticSpecsAreValidatedToo) {
   EXPECT_THROW(resolve_spec(s), Error);
 }
 
-// rit.history_reject changes the history blend: without the blend it is an error naming the key.
-TEST(ArchSpec, HistoryRejectNeedsTheBlend) {
-  const std::string rit = "backbone: pan\nrit: {enabled: true, channels: [history], source: hr_fuse, history_reject: true";
-  const std::string alone = parse_error(rit + "}\n");
-  EXPECT_NE(alone.find("rit.history_reject"), std::string::npos) << alone;
-  EXPECT_NE(alone.find("set rit.history_blend"), std::string::npos) << alone;
-  const ArchSpec s = spec_from_yaml(rit + ", history_blend: true}\n", "spec");
-  EXPECT_TRUE(s.rit.history_reject);
-  EXPECT_NE(spec_summary(s).find("history blend, reject"), std::string::npos) << spec_summary(s);
-  EXPECT_EQ(spec_from_yaml(spec_to_yaml(s), "roundtrip"), s);
-}
-
 // rit.bsp_composite, rit.history_blend and rit.skip_at_jitter read their channel at HR: without
 // the channel, with rit.source lr or without a RIT it is an error naming the key; each is written
 // only when set. skip_at_jitter moves PAN's bilinear skip: another backbone or skip is an error.

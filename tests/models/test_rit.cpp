@@ -340,55 +340,6 @@ TEST(Rit, HistoryBlendIsTheNetworkWithoutASampleAndLearnsToTakeOne) {
     }
 }
 
-// rit.history_reject: the blend's conv also reads relu(d) and relu(-d), d = sample - image. Driven
-// to trust a sample only when it is close to the image, it takes the close samples and keeps the
-// image where a sample is far off, which a weight of the image and the info alone cannot tell
-// apart; the graph computes what forward() does, deployed too.
-TEST(Rit, HistoryRejectTakesTheSamplesCloseToTheImage) {
-  torch::manual_seed(37);
-  for (const auto& source : rit_sources_for("pan")) {
-    if (source == "lr") continue;
-    SCOPED_TRACE(source);
-    ArchSpec spec = with_rit(default_spec("pan", 2), source);
-    spec.rit.channels = {"edge", "history"};
-    spec.rit.history_blend = true;
-    SRNetwork blend(resolve_spec(spec));
-    spec.rit.history_reject = true;
-    SRNetwork net(resolve_spec(spec));
-    randomize_fusion(*net, 0.1);
-    // The blend's conv reads 6 more channels: (3 + 5 + 6) * 3 * 9 weights and 3 biases in all.
-    EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*blend) + 6 * 3 * 9);
-    auto [color, info] = random_inputs(net->spec(), 9, 7);
-    torch::NoGradGuard no_grad;
-    net->rit()->gate.narrow(0, 1, 4).zero_();  // the network's image does not read the history
-    // The weight: sigmoid(20 - 400 * (relu(d) + relu(-d))) (centre taps): about 1 for |d| < 0.03,
-    // about 0 for |d| > 0.07.
-    auto& blend_conv = net->rit()->blend;
-    blend_conv->weight.zero_();
-    blend_conv->bias.fill_(20.0f);
-    for (int k = 0; k < 3; ++k) {
-      blend_conv->weight[k][8 + k][1][1] = -400.0f;
-      blend_conv->weight[k][11 + k][1][1] = -400.0f;
-    }
-    info.select(1, 4).zero_();
-    const auto image = net->forward(color, info);  // no sample anywhere: the network's image
-    // Every pixel a current-frame sample: within 0.01 of the image on the left half, 0.5 off on the right.
-    info.select(1, 4).fill_(1.0f);
-    const int64_t W = image.size(3), left = W / 2, right = W - W / 2;
-    auto history = info.slice(1, 1, 4);
-    history.copy_(image + 0.01);
-    history.narrow(3, left, right).copy_(image.narrow(3, left, right) + 0.5);
-    const auto out = net->forward(color, info);
-    EXPECT_TRUE(torch::allclose(out.narrow(3, 0, left), history.narrow(3, 0, left), 1e-5, 1e-5));
-    EXPECT_TRUE(torch::allclose(out.narrow(3, left, right), image.narrow(3, left, right), 1e-5, 1e-5));
-    for (bool training : {true, false}) {
-      const auto g = net->describe(training);
-      const auto ran = graph::run(g, network_inputs(g, color, info)).front().second;
-      EXPECT_TRUE(torch::allclose(ran, out, 1e-5, 1e-5)) << (training ? "training graph" : "deployed graph");
-    }
-  }
-}
-
 // rit.skip_at_jitter at every scale and HR source: at jitter 0 the output is the same network's
 // without the option; a jitter of one whole LR pixel reads the skip one LR pixel over (x right,
 // y down), so away from the border the output moves by the skip of the shifted image; the graph

@@ -316,12 +316,9 @@ void expect_trains_and_exports(const std::string& scratch, const std::string& ri
   fs::remove_all(dir);
 }
 
-// rit.history_blend with history_reject through the command line: ONNX Runtime and OpenCV
-// reproduce the blend and its weight's |sample - image| inputs.
+// rit.history_blend through the command line: ONNX Runtime and OpenCV reproduce the blend.
 TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
-  expect_trains_and_exports("history-blend",
-                            "--set 'enhance.rit.channels=[depth, history]' --set enhance.rit.history_blend=true"
-                            " --set enhance.rit.history_reject=true",
+  expect_trains_and_exports("history-blend", "--set 'enhance.rit.channels=[depth, history]' --set enhance.rit.history_blend=true",
                             "[1, 5, 96, 128]");  // depth 1 + history 4
 }
 
