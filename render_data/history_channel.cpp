@@ -99,23 +99,6 @@ torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale
         if (!same_surface_depth(p[k].ld[s], ref, depth_test.sample)) continue;
         const int64_t to = i * W + j;
         for (int c = 0; c < 3; ++c) o[c * plane + to] = p[k].c[c * lr_plane + s];
-        if (k > 0) {
-          // An older sample is clamped to the colours of the current frame's 3x3 LR pixels around p
-          // (TAA's neighbourhood clamp): a stale colour that passed the depth test cannot leave them.
-          const double cx = (j + 0.5) / scale + frames[0].jitter[0], cy = (i + 0.5) / scale + frames[0].jitter[1];
-          const int64_t x0 = std::clamp<int64_t>(static_cast<int64_t>(std::floor(cx)), 0, w - 1);
-          const int64_t y0 = std::clamp<int64_t>(static_cast<int64_t>(std::floor(cy)), 0, h - 1);
-          for (int c = 0; c < 3; ++c) {
-            float lo = INFINITY, hi = -INFINITY;
-            for (int64_t yy = std::max<int64_t>(0, y0 - 1); yy <= std::min(h - 1, y0 + 1); ++yy)
-              for (int64_t xx = std::max<int64_t>(0, x0 - 1); xx <= std::min(w - 1, x0 + 1); ++xx) {
-                const float v = p[0].c[c * lr_plane + yy * w + xx];
-                lo = std::min(lo, v);
-                hi = std::max(hi, v);
-              }
-            o[c * plane + to] = std::clamp(o[c * plane + to], lo, hi);
-          }
-        }
         o[3 * plane + to] = 1.0f - static_cast<float>(k) / (kHistoryFrames + 1);
         break;
       }
