@@ -41,13 +41,14 @@ struct Point {
   double cost = 0, psnr = 0;  // mean over frames: cost in ms, PSNR in dB
 };
 
-// Per frame: tiles[t] = {y, x} of its top-left HR pixel; sse[k][t]; edges[t] in [0, 1].
+// One test frame, every pattern's output and its tiles.
 struct TiledFrame {
-  std::vector<torch::Tensor> outputs;  // [pattern] clamped HR output, [1, 3, H, W]
+  std::vector<torch::Tensor> outputs;         // [pattern] clamped HR output, [1, 3, H, W]
   torch::Tensor hr;
-  std::vector<std::array<int64_t, 2>> tiles;
-  std::vector<std::vector<double>> sse;
-  std::vector<double> edges, detail, area;  // per tile
+  std::vector<std::array<int64_t, 2>> tiles;  // {y, x} of each tile's top-left HR pixel
+  std::vector<std::vector<double>> sse;       // [pattern][tile] squared error
+  // Per tile: share of geometry-edge pixels, mean LR colour gradient, share of the frame's area.
+  std::vector<double> edges, detail, area;
 };
 
 // The frame whose tile t is pattern choice[t]'s output.
