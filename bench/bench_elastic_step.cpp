@@ -5,11 +5,11 @@
 // timed steps, in channels-last (the layout training measures fastest here).
 //
 //   bench_elastic_step [--batch 4] [--patch 24] [--steps 30] [--threads 2]
+#include <CLI/CLI.hpp>
 #include <torch/torch.h>
 
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -24,14 +24,12 @@ using namespace cgsr;
 
 int main(int argc, char** argv) {
   int batch = 4, patch = 24, steps = 30, threads = 2;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    const int v = std::atoi(argv[i + 1]);
-    if (flag == "--batch") batch = v;
-    else if (flag == "--patch") patch = v;
-    else if (flag == "--steps") steps = v;
-    else if (flag == "--threads") threads = v;
-  }
+  CLI::App app{"The cost of training an elastic network's subnets, per forward + backward"};
+  app.add_option("--batch", batch, "patches per step")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--patch", patch, "LR patch side, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--steps", steps, "timed steps")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--threads", threads, "LibTorch and TBB threads (0 = all hardware threads)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   set_threads(threads);
   seed_everything(0);
   ArchSpec spec = default_spec("pan", 2);

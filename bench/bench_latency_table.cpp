@@ -5,11 +5,11 @@
 // every pair.
 //
 //   bench_latency_table [--width 320] [--height 240] [--subnets 20] [--runs 5] [--threads 2] [--precision int8]
+#include <CLI/CLI.hpp>
 #include <torch/torch.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <string>
 
@@ -22,17 +22,18 @@ using namespace cgsr;
 
 int main(int argc, char** argv) {
   int width = 320, height = 240, subnets = 20, runs = 5, threads = 2;
-  Precision precision = Precision::Fp32;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    const int v = std::atoi(argv[i + 1]);
-    if (flag == "--precision") precision = enum_from_name<Precision>(argv[i + 1]);
-    else if (flag == "--width") width = v;
-    else if (flag == "--height") height = v;
-    else if (flag == "--subnets") subnets = v;
-    else if (flag == "--runs") runs = v;
-    else if (flag == "--threads") threads = v;
-  }
+  std::string precision_name = enum_name(Precision::Fp32);
+  CLI::App app{"The latency table's predictions against the fused path's measurements, on random subnets"};
+  app.add_option("--width", width, "LR width, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--height", height, "LR height, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--subnets", subnets, "random subnets predicted and measured")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--runs", runs, "timed runs per measurement")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--threads", threads, "LibTorch and TBB threads (0 = all hardware threads)")->capture_default_str();
+  app.add_option("--precision", precision_name, "the precision the subnets run in")
+      ->check(CLI::IsMember(EnumNames<Precision>::names()))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  const Precision precision = enum_from_name<Precision>(precision_name);
   set_threads(threads);
   seed_everything(0);
   ArchSpec spec = default_spec("pan", 2);

@@ -10,6 +10,7 @@
 // the static network (the widest pattern), each pattern alone, each --baseline model (a static
 // network at the hybrid's mean MACs, the control), and the hybrid model (choosing and running,
 // frame after frame); then how often the hybrid chose each pattern.
+#include <CLI/CLI.hpp>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -31,27 +32,14 @@ int main(int argc, char** argv) {
   int rounds = 20, threads = 0;
   std::string model_path, data_path, split = "test";
   std::vector<std::string> baseline_paths;
-  bool usage = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(arg + " needs a value");
-      return argv[++i];
-    };
-    if (arg == "--rounds") rounds = std::stoi(value());
-    else if (arg == "--model") model_path = value();
-    else if (arg == "--data") data_path = value();
-    else if (arg == "--baseline") baseline_paths.push_back(value());
-    else if (arg == "--split") split = value();
-    else if (arg == "--threads") threads = std::stoi(value());
-    else usage = true;
-  }
-  if (usage || model_path.empty() || data_path.empty()) {
-    std::fprintf(stderr,
-                 "usage: bench_pruning --model pruned.cgsr --data DATA_DIR [--baseline MODEL ...] [--split test] [--rounds N] "
-                 "[--threads N]\n");
-    return 2;
-  }
+  CLI::App app{"Latency of a hybrid-pruned model against its static network, per frame over a sequence"};
+  app.add_option("--model", model_path, "a hybrid-pruned model (cgsr prune's pruned.cgsr)")->required();
+  app.add_option("--data", data_path, "the data set")->required();
+  app.add_option("--baseline", baseline_paths, "a static model to time beside it (repeatable)");
+  app.add_option("--split", split, "the split whose frames run")->capture_default_str();
+  app.add_option("--rounds", rounds, "interleaved timing rounds")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--threads", threads, "LibTorch and TBB threads (0 = all hardware threads)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   set_threads(threads);
   const Dataset data = Dataset::open(data_path);
   HybridUpscaler hybrid("hybrid", load_hybrid_model(model_path));

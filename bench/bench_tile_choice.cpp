@@ -15,6 +15,7 @@
 //   - detail per tile: the same, ranking tiles by the LR frame's mean absolute colour gradient;
 //   - oracle per frame: the same Lagrangian with one pattern per frame (what the hybrid chooses).
 // Prints each pattern alone and each chooser's best PSNR at no more than that pattern's cost.
+#include <CLI/CLI.hpp>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -91,27 +92,14 @@ int main(int argc, char** argv) {
   int64_t tile_lr = 40;
   std::string model_path, data_path;
   EvalOptions eval;
-  bool usage = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(arg + " needs a value");
-      return argv[++i];
-    };
-    if (arg == "--model") model_path = value();
-    else if (arg == "--data") data_path = value();
-    else if (arg == "--split") eval.split = value();
-    else if (arg == "--frames") eval.frames = value();
-    else if (arg == "--tile") tile_lr = std::stoll(value());
-    else if (arg == "--threads") threads = std::stoi(value());
-    else usage = true;
-  }
-  if (usage || model_path.empty() || data_path.empty() || tile_lr < 1) {
-    std::fprintf(stderr,
-                 "usage: bench_tile_choice --model pruned.cgsr --data DATA_DIR [--split test] [--frames A:B] "
-                 "[--tile LR_PIXELS] [--threads N]\n");
-    return 2;
-  }
+  CLI::App app{"The bound on choosing a hybrid's pattern per tile instead of per frame"};
+  app.add_option("--model", model_path, "a hybrid-pruned model (cgsr prune's pruned.cgsr)")->required();
+  app.add_option("--data", data_path, "the data set")->required();
+  app.add_option("--split", eval.split, "the split to evaluate")->capture_default_str();
+  app.add_option("--frames", eval.frames, "frames of the split, A:B (all when empty)");
+  app.add_option("--tile", tile_lr, "tile side, LR pixels")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--threads", threads, "LibTorch and TBB threads (0 = all hardware threads)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   set_threads(threads);
   torch::NoGradGuard no_grad;
   const Dataset data = Dataset::open(data_path);

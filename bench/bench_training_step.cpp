@@ -5,12 +5,11 @@
 // second and, per layout, the milliseconds of a step spent in each phase.
 //
 //   bench_training_step [--batch 4] [--patch 24] [--steps 60] [--warmup 5] [--threads 2] [--loss l2]
+#include <CLI/CLI.hpp>
 #include <torch/torch.h>
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 
 #include "core/runtime.h"
@@ -78,22 +77,16 @@ std::string phases_json(const StepPhases& p, int steps) {
 
 int main(int argc, char** argv) {
   int batch = 4, patch = 24, steps = 60, warmup = 5, threads = 2;
-  ErrorNorm norm = ErrorNorm::L2;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    const int value = std::atoi(argv[i + 1]);
-    if (flag == "--loss") norm = enum_from_name<ErrorNorm>(argv[i + 1]);
-    else if (flag == "--batch") batch = value;
-    else if (flag == "--patch") patch = value;
-    else if (flag == "--steps") steps = value;
-    else if (flag == "--warmup") warmup = value;
-    else if (flag == "--threads") threads = value;
-    else {
-      std::fprintf(stderr, "usage: bench_training_step [--batch N] [--patch N] [--steps N] [--warmup N] [--threads N] "
-                           "[--loss l2|l1|ssim]\n");
-      return 2;
-    }
-  }
+  std::string loss_name = enum_name(ErrorNorm::L2);
+  CLI::App app{"cgsr's training step alone, in NCHW and channels-last"};
+  app.add_option("--batch", batch, "patches per step")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--patch", patch, "LR patch side, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--steps", steps, "timed steps")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--warmup", warmup, "untimed steps first")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--threads", threads, "LibTorch and TBB threads (0 = all hardware threads)")->capture_default_str();
+  app.add_option("--loss", loss_name, "the image loss")->check(CLI::IsMember(EnumNames<ErrorNorm>::names()))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  const ErrorNorm norm = enum_from_name<ErrorNorm>(loss_name);
   set_threads(threads);
   StepPhases nchw_phases, nhwc_phases;
   const double nchw = steps_per_second(MemoryLayout::Nchw, batch, patch, steps, warmup, norm, nchw_phases);
