@@ -25,7 +25,14 @@ void setup_run(CLI::App& app) {
       pipeline_schema,
       [](CLI::App& sub, std::vector<FlagAssignment>& flags) {
         flag_to_key(sub, flags, "--from", "from", "rerun this stage and every later one (" + join(pipeline_stages()) + ")");
-        flag_to_key(sub, flags, "--data", "data", "use this data set instead of rendering the scene");
+        // --data replaces the config's scene (the config may name either, not both).
+        sub.add_option_function<std::string>(
+            "--data",
+            [&flags](const std::string& dir) {
+              flags.push_back({"scene=''", "--data " + dir});
+              flags.push_back({"data=" + dir, "--data " + dir});
+            },
+            "use this data set instead of rendering the config's scene (config key 'data')");
       },
       [](const PipelineOptions& options, const YAML::Node& resolved, RunDir* run_dir) {
         const fs::path dir = run_root(options);

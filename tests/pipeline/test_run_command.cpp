@@ -300,6 +300,11 @@ TEST(RunCommand, CheckReadsEverySceneConfigAndWritesNothing) {
   EXPECT_NE(ok.out.find("heldout  1 scene(s), 2 frames each"), std::string::npos) << ok.out;
   EXPECT_NE(ok.out.find("cgsr run: the config is valid"), std::string::npos) << ok.out;
   EXPECT_FALSE(fs::exists(dir / "run"));
+  // --data replaces the config's scene rather than clashing with it.
+  const CliResult data = run_cgsr(base + " --data " + (dir / "some_data").string());
+  ASSERT_EQ(data.exit_code, 0) << data.err;
+  EXPECT_NE(data.out.find("data     " + (dir / "some_data").string()), std::string::npos) << data.out;
+  EXPECT_EQ(data.out.find("render "), std::string::npos) << data.out;
   // The scratch control trains as long as the pick's weights did: train 6 + enhance 4 + elastic
   // 4 + fine-tuning 2, or only the last two when the elastic network starts from scratch.
   const CliResult steps = run_cgsr(base + " --set scratch.steps=0");
