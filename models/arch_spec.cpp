@@ -184,6 +184,8 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
     problems.push_back({"rit.skip_at_jitter", info.has_image_skip
                                                   ? "moves a bilinear image skip; image_skip is " + enum_name(spec.image_skip)
                                                   : spec.backbone + " adds no interpolated image to its output to move"});
+  if (spec.rit.residual_at_jitter && !spec.rit.skip_at_jitter)
+    problems.push_back({"rit.residual_at_jitter", "moves the residual over the skip that skip_at_jitter moves; set skip_at_jitter"});
   if (spec.geometry.enabled && !spec.rit.enabled)
     problems.push_back({"geometry.enabled", "the geometry head predicts the RIT's rendering channels; enable rit"});
   if (spec.geometry.width < 1)
@@ -267,6 +269,9 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("skip_at_jitter", &RitSpec::skip_at_jitter,
             "interpolate the bilinear image skip at the jitter channel's offsets (the unjittered output grid)");
   rit.omit_when("skip_at_jitter", [](const RitSpec& r) { return !r.skip_at_jitter; });
+  rit.field("residual_at_jitter", &RitSpec::residual_at_jitter,
+            "resample the rest of the output (over the skip) at the jitter too, at the output resolution");
+  rit.omit_when("residual_at_jitter", [](const RitSpec& r) { return !r.residual_at_jitter; });
   return rit;
 }
 
@@ -333,7 +338,7 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
          " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") +
-         (r.skip_at_jitter ? ", skip at jitter" : "") + "]";
+         (r.skip_at_jitter ? (r.residual_at_jitter ? ", output at jitter" : ", skip at jitter") : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

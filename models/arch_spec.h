@@ -28,6 +28,8 @@
 //                            #   weight (needs history among channels, an HR source)
 //     skip_at_jitter: false  # PAN's bilinear image skip taken at the jitter channel's offsets
 //                            #   (needs jitter among channels, an HR source)
+//     residual_at_jitter: false  # the rest of the output moved to the jitter as well, at HR
+//                            #   (needs skip_at_jitter)
 //   geometry:                # training-only head predicting the HR rendering information
 //     enabled: true
 //     width: 16
@@ -119,6 +121,10 @@ struct RitSpec {
   // output pixel's own position in a jittered LR frame, where the unjittered skip reads it up to
   // half an LR pixel off.
   bool skip_at_jitter = false;
+  // With skip_at_jitter, the rest of the output too (the network's residual over its skip): the
+  // backbone reads the jittered frame as if aligned, so its detail sits s * jitter HR pixels off;
+  // it is resampled there at HR (rit.h).
+  bool residual_at_jitter = false;
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
@@ -132,7 +138,8 @@ struct RitSpec {
   bool operator==(const RitSpec& o) const {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
            hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding &&
-           bsp_composite == o.bsp_composite && history_blend == o.history_blend && skip_at_jitter == o.skip_at_jitter;
+           bsp_composite == o.bsp_composite && history_blend == o.history_blend && skip_at_jitter == o.skip_at_jitter &&
+           residual_at_jitter == o.residual_at_jitter;
   }
 };
 

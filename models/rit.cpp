@@ -90,6 +90,7 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     jitter_offsets_ = torch::zeros({2, c, 1, 1});
     jitter_offsets_[0][offset] = 1.0f;
     jitter_offsets_[1][offset + 1] = 1.0f;
+    if (rit.residual_at_jitter) hr_jitter_offsets_ = jitter_offsets_ * static_cast<float>(scale);
   }
   if (rit.history_blend || rit.skip_at_jitter) {
     negate_scale_ = torch::full({3}, -1.0f);
@@ -180,7 +181,11 @@ torch::Tensor RitBlockImpl::skip_at_jitter(const torch::Tensor& image, const tor
   const auto at_jitter = graph::apply_sample(lr_color, torch::conv2d(info, jitter_offsets_), scale_,
                                              graph::ResizeMode::Bilinear);
   const auto unjittered = graph::apply_resize(lr_color, scale_, graph::ResizeMode::Bilinear);
-  return image + (at_jitter + graph::apply_affine(unjittered, negate_scale_, negate_shift_));
+  const auto negated = graph::apply_affine(unjittered, negate_scale_, negate_shift_);
+  if (!hr_jitter_offsets_.defined()) return image + (at_jitter + negated);
+  const auto residual = graph::apply_sample(image + negated, torch::conv2d(info, hr_jitter_offsets_), 1,
+                                            graph::ResizeMode::Bilinear);
+  return residual + at_jitter;
 }
 
 int RitBlockImpl::describe_skip_at_jitter(graph::Builder& g, int image, int lr_color, int info) const {
@@ -189,7 +194,11 @@ int RitBlockImpl::describe_skip_at_jitter(graph::Builder& g, int image, int lr_c
   const int at_jitter = g.sample(lr_color, offsets, graph::ResizeMode::Bilinear);
   const int unjittered = g.resize(lr_color, scale_, graph::ResizeMode::Bilinear);
   const int negated = g.affine("skip_negate", unjittered, negate_scale_, negate_shift_, /*trainable=*/false);
-  return g.add(image, g.add(at_jitter, negated));
+  if (!hr_jitter_offsets_.defined()) return g.add(image, g.add(at_jitter, negated));
+  const int hr_offsets = g.conv("hr_jitter_offsets", info, hr_jitter_offsets_, {}, 0, graph::fixed_layout("jitter", 2),
+                                /*trainable=*/false);
+  const int residual = g.sample(g.add(image, negated), hr_offsets, graph::ResizeMode::Bilinear);
+  return g.add(residual, at_jitter);
 }
 
 }  // namespace cgsr

@@ -48,6 +48,11 @@
 // image at (j + 0.5) / s - 0.5 + jitter (graph Sample, bilinear), the unjittered output grid.
 // Without jitter (0) both interpolations are the same and the output is the network's. No
 // parameters: fixed 0/1 1x1 convs pick the jitter out of the info input.
+//
+// rit.residual_at_jitter (with skip_at_jitter): the backbone reads the jittered LR frame as if it
+// were aligned, so the detail it adds over its skip sits s * jitter HR pixels from where it
+// belongs. The residual is resampled there too: out = sample_hr(net - bilinear(lr), s * jitter) +
+// sample(lr, jitter), bilinear at the output resolution (border padding). No parameters.
 
 #include <torch/nn/module.h>
 #include <torch/nn/modules/conv.h>
@@ -123,8 +128,9 @@ class RitBlockImpl : public torch::nn::Module {
   // history_blend: constants, [3, C, 1, 1] selections of the history colour and of its recency
   // (broadcast to R, G, B); and -x as scale -1, shift 0.
   torch::Tensor history_color_, history_recency_, negate_scale_, negate_shift_;
-  // skip_at_jitter: a constant [2, C, 1, 1] selection of the jitter (x, y); the scale.
-  torch::Tensor jitter_offsets_;
+  // skip_at_jitter: a constant [2, C, 1, 1] selection of the jitter (x, y); residual_at_jitter:
+  // the same times the scale (the jitter in HR pixels), else undefined.
+  torch::Tensor jitter_offsets_, hr_jitter_offsets_;
   int64_t scale_;
 };
 TORCH_MODULE(RitBlock);

@@ -212,4 +212,9 @@ TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
     EXPECT_NE(error.find(other == "backbone: edsr" ? "adds no interpolated image" : "image_skip is bicubic"), std::string::npos)
         << error;
   }
+  // residual_at_jitter moves the residual over the moved skip: without skip_at_jitter it is an error.
+  const std::string alone = parse_error(
+      "backbone: pan\nrit: {enabled: true, channels: [jitter], source: hr_fuse, residual_at_jitter: true}\n");
+  EXPECT_NE(alone.find("rit.residual_at_jitter"), std::string::npos) << alone;
+  EXPECT_NE(alone.find("set skip_at_jitter"), std::string::npos) << alone;
 }

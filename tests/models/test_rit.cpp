@@ -384,6 +384,56 @@ TEST(Rit, SkipAtJitterMovesPansSkipToTheJitter) {
     }
 }
 
+// rit.residual_at_jitter: at jitter 0 the output is the network's without it; a jitter of one
+// whole LR pixel moves the skip as above and the residual over it by s HR pixels (x right, y down),
+// so away from the border the output is the skip of the shifted image plus the plain network's
+// residual shifted; graph and deployed graph compute the same; no parameter is added.
+TEST(Rit, ResidualAtJitterMovesTheWholeOutput) {
+  torch::manual_seed(41);
+  for (int scale : {2, 3}) {
+    SCOPED_TRACE(scale);
+    ArchSpec spec = with_rit(default_spec("pan", scale), "hr_unshuffle+hr_fuse");
+    spec.rit.skip_at_jitter = true;
+    auto [plain, net] = with_and_without(spec, {"edge", "jitter"}, &RitSpec::residual_at_jitter);
+    EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
+    auto [color, info] = random_inputs(net->spec(), 9, 7);
+    torch::NoGradGuard no_grad;
+    info.narrow(1, 1, 2).zero_();
+    EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
+    const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
+    const int64_t s = scale, h = color.size(2), w = color.size(3);
+    for (int axis : {0, 1}) {
+      SCOPED_TRACE(axis == 0 ? "x" : "y");
+      info.narrow(1, 1, 2).zero_();
+      info.select(1, 1 + axis).fill_(1.0f);
+      // The residual over the skip moved by `by` HR pixels (the last column or row repeats).
+      const auto moved_residual = [&](const torch::Tensor& r, int64_t by) {
+        const int dim = axis == 0 ? 3 : 2;
+        const int64_t n = r.size(dim);
+        return torch::cat({r.narrow(dim, by, n - by), r.narrow(dim, n - 1, 1).expand_as(r.narrow(dim, 0, by))}, dim);
+      };
+      const auto shifted = axis == 0 ? torch::cat({color.narrow(3, 1, w - 1), color.narrow(3, w - 1, 1)}, 3)
+                                     : torch::cat({color.narrow(2, 1, h - 1), color.narrow(2, h - 1, 1)}, 2);
+      // The plain network on this info (the jitter planes are RIT inputs too) adds its residual
+      // to the moved skip.
+      const auto skip_moved = plain->forward(color, info);
+      const auto expected = skip(shifted) + moved_residual(skip_moved - skip(shifted), s);
+      const auto out = net->forward(color, info);
+      const auto inner = [&](const torch::Tensor& t) { return t.narrow(2, s, (h - 2) * s).narrow(3, s, (w - 2) * s); };
+      EXPECT_TRUE(torch::allclose(inner(out), inner(expected), 1e-4, 1e-4))
+          << (inner(out) - inner(expected)).abs().max().item<float>();
+      EXPECT_FALSE(torch::allclose(inner(out), inner(skip_moved), 1e-3, 1e-3));
+    }
+    info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
+    const auto out = net->forward(color, info);
+    const auto g = net->describe(/*training=*/true);
+    EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second, out));
+    const auto deployed = net->describe(/*training=*/false);
+    EXPECT_TRUE(torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5,
+                                1e-5));
+  }
+}
+
 // The training augmentations keep the skip at the jitter right: flipping or rotating a frame and
 // transforming its jitter like a motion vector (render_data/augment.h) gives the interpolation of
 // the flipped or rotated frame.
