@@ -94,7 +94,8 @@ class RitBlockImpl : public torch::nn::Module {
   bool blends_history() const { return !blend.is_empty(); }
   torch::Tensor blend_history(const torch::Tensor& image, const torch::Tensor& info);
   int describe_blend_history(graph::Builder& g, int image, int info) const;
-  // rit.skip_at_jitter: the image with its bilinear skip of `lr_color` moved to the jitter of `info`.
+  // rit.skip_at_jitter: the image with its bilinear skip of `lr_color` moved to the jitter of `info`
+  // (with residual_at_jitter, the rest of the image too).
   bool skips_at_jitter() const { return jitter_offsets_.defined(); }
   torch::Tensor skip_at_jitter(const torch::Tensor& image, const torch::Tensor& lr_color, const torch::Tensor& info) const;
   int describe_skip_at_jitter(graph::Builder& g, int image, int lr_color, int info) const;

@@ -322,12 +322,12 @@ TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
                             "[1, 5, 96, 128]");  // depth 1 + history 4
 }
 
-// rit.skip_at_jitter with the blend: the jitter channel is derived for the network, and ONNX
-// Runtime reproduces it (its GridSample included; OpenCV DNN has none).
-TEST(HistoryChannel, ANetworkTakingItsSkipAtTheJitterTrainsAndExports) {
-  expect_trains_and_exports("skip-at-jitter",
+// rit.skip_at_jitter and rit.residual_at_jitter with the blend: the jitter channel is derived for
+// the network, and ONNX Runtime reproduces it (both GridSamples included; OpenCV DNN has none).
+TEST(HistoryChannel, ANetworkTakingItsOutputAtTheJitterTrainsAndExports) {
+  expect_trains_and_exports("output-at-jitter",
                             "--set 'enhance.rit.channels=[depth, history, jitter]' --set enhance.rit.history_blend=true"
-                            " --set enhance.rit.skip_at_jitter=true",
+                            " --set enhance.rit.skip_at_jitter=true --set enhance.rit.residual_at_jitter=true",
                             "[1, 7, 96, 128]");  // 1 + 4 + 2
 }
 
