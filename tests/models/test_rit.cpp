@@ -340,6 +340,31 @@ TEST(Rit, HistoryBlendIsTheNetworkWithoutASampleAndLearnsToTakeOne) {
     }
 }
 
+// `t` moved by `by` pixels along `axis` (0: x, 1: y): pixel i reads i + by, the last column or row
+// repeating.
+torch::Tensor moved_by(const torch::Tensor& t, int axis, int64_t by) {
+  const int dim = axis == 0 ? 3 : 2;
+  const int64_t n = t.size(dim);
+  return torch::cat({t.narrow(dim, by, n - by), t.narrow(dim, n - 1, 1).expand_as(t.narrow(dim, 0, by))}, dim);
+}
+
+// An HR image without its outer LR pixel (s HR pixels), where interpolations clamp differently.
+torch::Tensor inner(const torch::Tensor& t, int64_t s) {
+  return t.narrow(2, s, t.size(2) - 2 * s).narrow(3, s, t.size(3) - 2 * s);
+}
+
+// At a random jitter (the info's channels 1, 2), the training graph computes exactly what forward()
+// does and the deployed graph the same within 1e-5.
+void expect_graphs_compute_forward(SRNetwork& net, const torch::Tensor& color, torch::Tensor& info) {
+  info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
+  const auto out = net->forward(color, info);
+  const auto g = net->describe(/*training=*/true);
+  EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second, out));
+  const auto deployed = net->describe(/*training=*/false);
+  EXPECT_TRUE(
+      torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5, 1e-5));
+}
+
 // rit.skip_at_jitter at every scale and HR source: at jitter 0 the output is the same network's
 // without the option; a jitter of one whole LR pixel reads the skip one LR pixel over (x right,
 // y down), so away from the border the output moves by the skip of the shifted image; the graph
@@ -359,35 +384,22 @@ TEST(Rit, SkipAtJitterMovesPansSkipToTheJitter) {
       info.narrow(1, 1, 2).zero_();
       EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
       const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
-      const int64_t s = scale, h = color.size(2), w = color.size(3);
       for (int axis : {0, 1}) {
         SCOPED_TRACE(axis == 0 ? "x" : "y");
         info.narrow(1, 1, 2).zero_();
         info.select(1, 1 + axis).fill_(1.0f);
-        const auto moved = net->forward(color, info) - plain->forward(color, info);
-        // The LR image one pixel over: pixel x reads x + 1 (the last column or row repeats).
-        const auto shifted = axis == 0 ? torch::cat({color.narrow(3, 1, w - 1), color.narrow(3, w - 1, 1)}, 3)
-                                       : torch::cat({color.narrow(2, 1, h - 1), color.narrow(2, h - 1, 1)}, 2);
-        const auto expected = skip(shifted) - skip(color);
-        // Away from the borders, where the two clamp differently.
-        const auto inner = [&](const torch::Tensor& t) { return t.narrow(2, s, (h - 2) * s).narrow(3, s, (w - 2) * s); };
-        EXPECT_TRUE(torch::allclose(inner(moved), inner(expected), 1e-4, 1e-4))
-            << (inner(moved) - inner(expected)).abs().max().item<float>();
+        const auto moved = inner(net->forward(color, info) - plain->forward(color, info), scale);
+        const auto expected = inner(skip(moved_by(color, axis, 1)) - skip(color), scale);
+        EXPECT_TRUE(torch::allclose(moved, expected, 1e-4, 1e-4)) << (moved - expected).abs().max().item<float>();
       }
-      info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
-      const auto out = net->forward(color, info);
-      const auto g = net->describe(/*training=*/true);
-      EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second, out));
-      const auto deployed = net->describe(/*training=*/false);
-      EXPECT_TRUE(torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5,
-                                  1e-5));
+      expect_graphs_compute_forward(net, color, info);
     }
 }
 
 // rit.residual_at_jitter: at jitter 0 the output is the network's without it; a jitter of one
 // whole LR pixel moves the skip as above and the residual over it by s HR pixels (x right, y down),
 // so away from the border the output is the skip of the shifted image plus the plain network's
-// residual shifted; graph and deployed graph compute the same; no parameter is added.
+// residual shifted; the graphs compute the same; no parameter is added.
 TEST(Rit, ResidualAtJitterMovesTheWholeOutput) {
   torch::manual_seed(41);
   for (int scale : {2, 3}) {
@@ -401,36 +413,20 @@ TEST(Rit, ResidualAtJitterMovesTheWholeOutput) {
     info.narrow(1, 1, 2).zero_();
     EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
     const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
-    const int64_t s = scale, h = color.size(2), w = color.size(3);
     for (int axis : {0, 1}) {
       SCOPED_TRACE(axis == 0 ? "x" : "y");
       info.narrow(1, 1, 2).zero_();
       info.select(1, 1 + axis).fill_(1.0f);
-      // The residual over the skip moved by `by` HR pixels (the last column or row repeats).
-      const auto moved_residual = [&](const torch::Tensor& r, int64_t by) {
-        const int dim = axis == 0 ? 3 : 2;
-        const int64_t n = r.size(dim);
-        return torch::cat({r.narrow(dim, by, n - by), r.narrow(dim, n - 1, 1).expand_as(r.narrow(dim, 0, by))}, dim);
-      };
-      const auto shifted = axis == 0 ? torch::cat({color.narrow(3, 1, w - 1), color.narrow(3, w - 1, 1)}, 3)
-                                     : torch::cat({color.narrow(2, 1, h - 1), color.narrow(2, h - 1, 1)}, 2);
       // The plain network on this info (the jitter planes are RIT inputs too) adds its residual
-      // to the moved skip.
+      // to the moved skip; this one moves that residual by s HR pixels as well.
       const auto skip_moved = plain->forward(color, info);
-      const auto expected = skip(shifted) + moved_residual(skip_moved - skip(shifted), s);
-      const auto out = net->forward(color, info);
-      const auto inner = [&](const torch::Tensor& t) { return t.narrow(2, s, (h - 2) * s).narrow(3, s, (w - 2) * s); };
-      EXPECT_TRUE(torch::allclose(inner(out), inner(expected), 1e-4, 1e-4))
-          << (inner(out) - inner(expected)).abs().max().item<float>();
-      EXPECT_FALSE(torch::allclose(inner(out), inner(skip_moved), 1e-3, 1e-3));
+      const auto moved_skip = skip(moved_by(color, axis, 1));
+      const auto expected = inner(moved_skip + moved_by(skip_moved - moved_skip, axis, scale), scale);
+      const auto out = inner(net->forward(color, info), scale);
+      EXPECT_TRUE(torch::allclose(out, expected, 1e-4, 1e-4)) << (out - expected).abs().max().item<float>();
+      EXPECT_FALSE(torch::allclose(out, inner(skip_moved, scale), 1e-3, 1e-3));
     }
-    info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
-    const auto out = net->forward(color, info);
-    const auto g = net->describe(/*training=*/true);
-    EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second, out));
-    const auto deployed = net->describe(/*training=*/false);
-    EXPECT_TRUE(torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5,
-                                1e-5));
+    expect_graphs_compute_forward(net, color, info);
   }
 }
 
