@@ -2,6 +2,8 @@
 // from a trained backbone computes exactly the backbone's output), gates, shapes, inputs.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "core/error.h"
 #include "models/importance/channel_importance.h"
 #include "models/inherit.h"
@@ -353,9 +355,26 @@ torch::Tensor inner(const torch::Tensor& t, int64_t s) {
   return t.narrow(2, s, t.size(2) - 2 * s).narrow(3, s, t.size(3) - 2 * s);
 }
 
-// At a random jitter (the info's channels 1, 2), the training graph computes exactly what forward()
+// `spec` with and without the jitter option `option`, reading edge and jitter (the jitter at info
+// channels 1, 2, so the offset counts): no parameter is added and at jitter 0 both compute the
+// same; `check(plain, net, color, info, axis)` then runs with a jitter of one whole LR pixel along x
+// (axis 0), then y; last, at a random jitter, the training graph computes exactly what forward()
 // does and the deployed graph the same within 1e-5.
-void expect_graphs_compute_forward(SRNetwork& net, const torch::Tensor& color, torch::Tensor& info) {
+using JitterCheck = std::function<void(SRNetwork& plain, SRNetwork& net, const torch::Tensor& color,
+                                       const torch::Tensor& info, int axis)>;
+void check_jitter_option(const ArchSpec& spec, bool RitSpec::*option, const JitterCheck& check) {
+  auto [plain, net] = with_and_without(spec, {"edge", "jitter"}, option);
+  EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
+  auto [color, info] = random_inputs(net->spec(), 9, 7);
+  torch::NoGradGuard no_grad;
+  info.narrow(1, 1, 2).zero_();
+  EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
+  for (int axis : {0, 1}) {
+    SCOPED_TRACE(axis == 0 ? "x" : "y");
+    info.narrow(1, 1, 2).zero_();
+    info.select(1, 1 + axis).fill_(1.0f);
+    check(plain, net, color, info, axis);
+  }
   info.narrow(1, 1, 2).uniform_(-0.5, 0.5);
   const auto out = net->forward(color, info);
   const auto g = net->describe(/*training=*/true);
@@ -365,68 +384,51 @@ void expect_graphs_compute_forward(SRNetwork& net, const torch::Tensor& color, t
       torch::allclose(graph::run(deployed, network_inputs(deployed, color, info)).front().second, out, 1e-5, 1e-5));
 }
 
-// rit.skip_at_jitter at every scale and HR source: at jitter 0 the output is the same network's
-// without the option; a jitter of one whole LR pixel reads the skip one LR pixel over (x right,
-// y down), so away from the border the output moves by the skip of the shifted image; the graph
-// computes what forward() does, deployed too; no parameter is added.
+// rit.skip_at_jitter at every scale and HR source: a jitter of one whole LR pixel reads the skip
+// one LR pixel over (x right, y down), so away from the border the output moves by the skip of the
+// shifted image.
 TEST(Rit, SkipAtJitterMovesPansSkipToTheJitter) {
   torch::manual_seed(31);
   for (int scale : {2, 3, 4})
     for (const auto& source : rit_sources_for("pan")) {
       if (source == "lr") continue;
       SCOPED_TRACE(std::to_string(scale) + " " + source);
-      // jitter at positions 1, 2: the offset counts
-      auto [plain, net] =
-          with_and_without(with_rit(default_spec("pan", scale), source), {"edge", "jitter"}, &RitSpec::skip_at_jitter);
-      EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
-      auto [color, info] = random_inputs(net->spec(), 9, 7);
-      torch::NoGradGuard no_grad;
-      info.narrow(1, 1, 2).zero_();
-      EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
       const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
-      for (int axis : {0, 1}) {
-        SCOPED_TRACE(axis == 0 ? "x" : "y");
-        info.narrow(1, 1, 2).zero_();
-        info.select(1, 1 + axis).fill_(1.0f);
-        const auto moved = inner(net->forward(color, info) - plain->forward(color, info), scale);
-        const auto expected = inner(skip(moved_by(color, axis, 1)) - skip(color), scale);
-        EXPECT_TRUE(torch::allclose(moved, expected, 1e-4, 1e-4)) << (moved - expected).abs().max().item<float>();
-      }
-      expect_graphs_compute_forward(net, color, info);
+      check_jitter_option(with_rit(default_spec("pan", scale), source), &RitSpec::skip_at_jitter,
+                          [&](SRNetwork& plain, SRNetwork& net, const torch::Tensor& color, const torch::Tensor& info,
+                              int axis) {
+                            const auto moved = inner(net->forward(color, info) - plain->forward(color, info), scale);
+                            const auto expected = inner(skip(moved_by(color, axis, 1)) - skip(color), scale);
+                            EXPECT_TRUE(torch::allclose(moved, expected, 1e-4, 1e-4))
+                                << (moved - expected).abs().max().item<float>();
+                          });
     }
 }
 
-// rit.residual_at_jitter: at jitter 0 the output is the network's without it; a jitter of one
-// whole LR pixel moves the skip as above and the residual over it by s HR pixels (x right, y down),
-// so away from the border the output is the skip of the shifted image plus the plain network's
-// residual shifted; the graphs compute the same; no parameter is added.
+// rit.residual_at_jitter: a jitter of one whole LR pixel moves the skip as above and the residual
+// over it by s HR pixels, so away from the border the output is the skip of the shifted image plus
+// the skip_at_jitter network's residual, shifted.
 TEST(Rit, ResidualAtJitterMovesTheWholeOutput) {
   torch::manual_seed(41);
   for (int scale : {2, 3}) {
     SCOPED_TRACE(scale);
     ArchSpec spec = with_rit(default_spec("pan", scale), "hr_unshuffle+hr_fuse");
     spec.rit.skip_at_jitter = true;
-    auto [plain, net] = with_and_without(spec, {"edge", "jitter"}, &RitSpec::residual_at_jitter);
-    EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
-    auto [color, info] = random_inputs(net->spec(), 9, 7);
-    torch::NoGradGuard no_grad;
-    info.narrow(1, 1, 2).zero_();
-    EXPECT_TRUE(torch::allclose(net->forward(color, info), plain->forward(color, info), 1e-5, 1e-5));
     const auto skip = [&](const torch::Tensor& lr) { return graph::apply_resize(lr, scale, graph::ResizeMode::Bilinear); };
-    for (int axis : {0, 1}) {
-      SCOPED_TRACE(axis == 0 ? "x" : "y");
-      info.narrow(1, 1, 2).zero_();
-      info.select(1, 1 + axis).fill_(1.0f);
-      // The plain network on this info (the jitter planes are RIT inputs too) adds its residual
-      // to the moved skip; this one moves that residual by s HR pixels as well.
-      const auto skip_moved = plain->forward(color, info);
-      const auto moved_skip = skip(moved_by(color, axis, 1));
-      const auto expected = inner(moved_skip + moved_by(skip_moved - moved_skip, axis, scale), scale);
-      const auto out = inner(net->forward(color, info), scale);
-      EXPECT_TRUE(torch::allclose(out, expected, 1e-4, 1e-4)) << (out - expected).abs().max().item<float>();
-      EXPECT_FALSE(torch::allclose(out, inner(skip_moved, scale), 1e-3, 1e-3));
-    }
-    expect_graphs_compute_forward(net, color, info);
+    check_jitter_option(spec, &RitSpec::residual_at_jitter,
+                        [&](SRNetwork& plain, SRNetwork& net, const torch::Tensor& color, const torch::Tensor& info,
+                            int axis) {
+                          // The plain network on this info (the jitter planes are RIT inputs too)
+                          // adds its residual to the moved skip; this one moves that residual too.
+                          const auto skip_moved = plain->forward(color, info);
+                          const auto moved_skip = skip(moved_by(color, axis, 1));
+                          const auto expected =
+                              inner(moved_skip + moved_by(skip_moved - moved_skip, axis, scale), scale);
+                          const auto out = inner(net->forward(color, info), scale);
+                          EXPECT_TRUE(torch::allclose(out, expected, 1e-4, 1e-4))
+                              << (out - expected).abs().max().item<float>();
+                          EXPECT_FALSE(torch::allclose(out, inner(skip_moved, scale), 1e-3, 1e-3));
+                        });
   }
 }
 
