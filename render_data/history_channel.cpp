@@ -76,8 +76,6 @@ torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale
     for (int64_t j = 0; j < W; ++j) {
       double qx = j + 0.5, qy = i + 0.5;
       float ref = p[0].d[i * W + j];  // the point's depth in the latest frame of the chain
-      double sum[3] = {0, 0, 0}, weight = 0;
-      float newest = 0;
       for (size_t k = 0; k < n; ++k) {
         if (k > 0) {
           // One link back: frame t-k+1's motion at the r-pixel containing the position.
@@ -99,15 +97,10 @@ torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale
         if (std::abs(scale * (x + 0.5 - jx) - qx) > 0.5 || std::abs(scale * (y + 0.5 - jy) - qy) > 0.5) continue;
         const int64_t s = y * w + x;
         if (!same_surface_depth(p[k].ld[s], ref, depth_test.sample)) continue;
-        const double r = 1.0 - static_cast<double>(k) / (kHistoryFrames + 1);
-        for (int c = 0; c < 3; ++c) sum[c] += r * p[k].c[c * lr_plane + s];
-        weight += r;
-        if (newest == 0) newest = static_cast<float>(r);
-      }
-      if (weight > 0) {
         const int64_t to = i * W + j;
-        for (int c = 0; c < 3; ++c) o[c * plane + to] = static_cast<float>(sum[c] / weight);
-        o[3 * plane + to] = newest;
+        for (int c = 0; c < 3; ++c) o[c * plane + to] = p[k].c[c * lr_plane + s];
+        o[3 * plane + to] = 1.0f - static_cast<float>(k) / (kHistoryFrames + 1);
+        break;
       }
     }
   });
