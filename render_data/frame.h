@@ -44,8 +44,8 @@ struct Frame {
   std::shared_ptr<const BspBorderImage> bsp_border;
   // Sub-pixel offset of this frame's projection, pixels of this resolution, each in [-0.5, 0.5):
   // the image content sits at p + jitter (render_data/jitter.h). {0, 0} when not jittered (every
-  // resolution but the smallest of a jittered cgsr data set, and every capture). An integer crop
-  // keeps it.
+  // resolution but the smallest of a jittered data set or capture, and a capture without a jitter
+  // file). An integer crop keeps it.
   std::array<double, 2> jitter{0, 0};
 
   bool has(RenderChannel channel) const;

@@ -4,10 +4,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/text.h"
 #include "render_data/dataset.h"
 #include "render_data/frame_files.h"
 
@@ -33,6 +36,7 @@ config::Schema<GlobLayoutOptions> glob_layout_schema() {
   s.field("depth_encoding", &GlobLayoutOptions::depth_encoding, "how depth is stored");
   s.field("depth_scale", &GlobLayoutOptions::depth_scale, "linear depth: metres per stored unit").range(1e-12, 1e12);
   s.section("motion_format", &GlobLayoutOptions::motion_format, motion_format_schema(), "how motion images map to pixels");
+  s.field("jitter", &GlobLayoutOptions::jitter, "text file of the LR frames' jitter offsets, one 'x y' line per frame");
   s.list("resolutions", &GlobLayoutOptions::resolutions, r, "one entry per resolution");
   s.validate([](const GlobLayoutOptions& o, const config::Cursor& at, const YAML::Node& node) {
     if (o.resolutions.empty()) at.child("resolutions").fail(node, "needs at least one resolution");
@@ -66,6 +70,33 @@ bool natural_less(const std::string& a, const std::string& b) {
     }
   }
   return a.size() - i < b.size() - j;
+}
+
+std::vector<std::array<double, 2>> read_jitter_file(const fs::path& path, int frames) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string(), "cannot open the jitter file");
+  std::vector<std::array<double, 2>> offsets;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string at = "line " + std::to_string(number) + ": ";
+    if (static_cast<int>(offsets.size()) == frames)
+      throw Error(path.string(), at + "more offsets than the capture's " + std::to_string(frames) + " frames");
+    std::istringstream fields(line);
+    std::array<double, 2> o{};
+    std::string extra;
+    if (!(fields >> o[0] >> o[1]) || (fields >> extra))
+      throw Error(path.string(), at + "expected two numbers 'x y', got '" + line + "'");
+    for (double v : o)
+      if (!(v >= -0.5 && v < 0.5))
+        throw Error(path.string(), at + "offset " + fixed(v, 4) + " is outside [-0.5, 0.5) pixels");
+    offsets.push_back(o);
+  }
+  if (static_cast<int>(offsets.size()) != frames)
+    throw Error(path.string(), "has " + std::to_string(offsets.size()) + " offsets for the capture's " +
+                                   std::to_string(frames) + " frames (one 'x y' line per frame)");
+  return offsets;
 }
 
 namespace {
@@ -184,6 +215,7 @@ class GlobDataset : public FrameSource {
       if (present[c]) info_.stored.push_back(all_render_channels()[c]);
     info_.frames = static_cast<int>(count);
     info_.split = make_split(info_.frames);
+    if (!o.jitter.empty()) jitter_ = read_jitter_file(base / o.jitter, info_.frames);
   }
 
   const DatasetInfo& info() const override { return info_; }
@@ -216,6 +248,7 @@ class GlobDataset : public FrameSource {
     Frame f;
     f.width = r.width;
     f.height = r.height;
+    if (res == 0 && !jitter_.empty()) f.jitter = jitter_.at(static_cast<size_t>(frame));
     f.color = decode(rf.color.at(frame), "color", [&](const ImageFile& image) { return decode_capture_color(image, color_alpha_); });
     const bool has_depth = std::find(channels.begin(), channels.end(), RenderChannel::Depth) != channels.end();
     if (has_depth) {
@@ -252,6 +285,7 @@ class GlobDataset : public FrameSource {
   ColorAlpha color_alpha_ = ColorAlpha::Ignore;
   DepthFormat depth_format_;
   MotionFormat motion_format_;
+  std::vector<std::array<double, 2>> jitter_;  // per frame, of resolution 0; empty: not jittered
 };
 
 fs::path glob_yaml(const fs::path& path) { return fs::is_directory(path) ? path / "dataset.yaml" : path; }

@@ -16,6 +16,7 @@
 //     x: {channels: [0, 1], scale: 2, offset: 0.5}   # [high, low] channels of a 16-bit code
 //     y: {channels: [2, 3], scale: -2, offset: 0.5}
 //     units: uv                 # pixels, or fractions of the frame's width and height
+//   jitter: lr/jitter.txt       # the LR frames' sub-pixel jitter, one "x y" line per frame (default: none)
 //   resolutions:
 //     - size: 640x360
 //       color: lr/color_*.png
@@ -27,7 +28,11 @@
 // Patterns are relative to the YAML file; wildcards (* and ?) only in the file name part. The
 // encodings are capture_format.h's; docs/captures.md walks through a real capture.
 // Other channels: normal ((n + 1) / 2 in an RGB image), normal_angle (grey), edge (grey, 0/1).
+// The jitter file gives the smallest resolution's offset per frame in cgsr's convention (LR
+// pixels in [-0.5, 0.5), the content at p + offset: render_data/jitter.h); blank lines and lines
+// starting with '#' are skipped.
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -50,6 +55,7 @@ struct GlobLayoutOptions {
   CaptureDepth depth_encoding = CaptureDepth::Normalized;
   double depth_scale = 1;
   MotionFormat motion_format;
+  std::string jitter;  // a text file of per-frame jitter offsets; empty: the frames are not jittered
   std::vector<GlobResolution> resolutions;
 };
 
@@ -59,5 +65,7 @@ config::Schema<GlobLayoutOptions> glob_layout_schema();
 std::vector<std::filesystem::path> glob_files(const std::filesystem::path& base, const std::string& pattern);
 // "frame2" < "frame10".
 bool natural_less(const std::string& a, const std::string& b);
+// The jitter file's offsets, one per frame; throws cgsr::Error naming the file and line.
+std::vector<std::array<double, 2>> read_jitter_file(const std::filesystem::path& path, int frames);
 
 }  // namespace cgsr

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <thread>
@@ -276,6 +277,90 @@ TEST(HistoryChannel, IsDeterministicAndAClearErrorWithoutMotion) {
     EXPECT_NE(what.find("'history'"), std::string::npos) << what;
     EXPECT_NE(what.find("32x24: the data set has no motion at 32x24"), std::string::npos) << what;
     EXPECT_NE(what.find("64x48: the data set has no motion at 64x48 and no depth at 64x48"), std::string::npos) << what;
+  }
+  fs::remove_all(root);
+}
+
+// A jittered sequence as an engine would capture it (the glob layout: PNG colour, float EXR depth
+// and motion at both resolutions) with its jitter in a text file: every frame's jitter and history
+// are the rendered data set's; without the file the frames load unjittered and their history
+// moves. A bad jitter file is an error naming the file and line.
+TEST(HistoryChannel, AJitteredCaptureWithItsJitterFileGivesTheRenderedHistory) {
+  const Dataset rendered = Dataset::open(jittered_data(), with_channels({"depth", "motion", "history"}));
+  const fs::path root = test::scratch_dir("history_capture");
+  const int frames = 8;
+  std::ofstream jitter(root / "jitter.txt");
+  jitter << "# x y, LR pixels\n" << std::setprecision(17);
+  std::string layout = "layout: glob\ndepth_encoding: linear\nresolutions:\n";
+  for (size_t res : {0, 1}) {
+    const std::string dir = res == 0 ? "lr" : "hr";
+    fs::create_directories(root / dir);
+    layout += "  - {size: " + rendered.info().resolutions[res].name() + ", color: " + dir + "/color_*.png, depth: " + dir +
+              "/depth_*.exr, motion: " + dir + "/mv_*.exr}\n";
+    for (int f = 0; f < frames; ++f) {
+      const Frame fr = rendered.load(f, res);
+      const std::string n = std::to_string(f);
+      write_image(root / dir / ("color_" + n + ".png"), fr.color_float());
+      write_image(root / dir / ("depth_" + n + ".exr"), torch::where(torch::isinf(fr.depth), torch::zeros({}), fr.depth), {32});
+      write_image(root / dir / ("mv_" + n + ".exr"), torch::cat({fr.motion.to(torch::kFloat32), torch::zeros({1, fr.height, fr.width})}), {32});
+      if (res == 0) jitter << fr.jitter[0] << " " << fr.jitter[1] << "\n";
+    }
+  }
+  jitter.close();
+  std::ofstream(root / "capture.yaml") << layout << "jitter: jitter.txt\n";
+  std::ofstream(root / "unjittered.yaml") << layout;
+  const Dataset capture = Dataset::open(root / "capture.yaml", with_channels({"history"}));
+  const Dataset unjittered = Dataset::open(root / "unjittered.yaml", with_channels({"history"}));
+  int moved = 0;
+  for (int f = 0; f < frames; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    EXPECT_EQ(capture.load(f, 0).jitter, rendered.load(f, 0).jitter);
+    EXPECT_TRUE(torch::equal(capture.load(f, 1).history, rendered.load(f, 1).history));
+    EXPECT_EQ(unjittered.load(f, 0).jitter, (std::array<double, 2>{0, 0}));
+    moved += !torch::equal(unjittered.load(f, 1).history, rendered.load(f, 1).history);
+  }
+  EXPECT_GE(moved, frames - 1);  // (a frame jittered by exactly 0 would load the same)
+  // cgsr eval runs the temporal upscalers on it: the jittered capture's history fill is the
+  // rendered data set's, to the last digit of the summary.
+  std::string psnr_of[2];
+  for (int i = 0; i < 2; ++i) {
+    const fs::path data = i == 0 ? root / "capture.yaml" : jittered_data();
+    const auto r = test::run_cgsr("eval --data " + data.string() + " --model history --frames 0:" + std::to_string(frames) +
+                                  " --split all --latency-runs 0 --out " + (root / ("eval" + std::to_string(i))).string());
+    ASSERT_EQ(r.exit_code, 0) << r.all();
+    const std::string summary = test::slurp(root / ("eval" + std::to_string(i)) / "results.json");
+    const auto at = summary.find("\"psnr\"");
+    ASSERT_NE(at, std::string::npos) << summary;
+    psnr_of[i] = summary.substr(at, 30);
+  }
+  EXPECT_EQ(psnr_of[0], psnr_of[1]);
+
+  auto open_error = [&](const std::string& lines) {
+    std::ofstream(root / "bad.txt") << lines;
+    std::ofstream(root / "bad.yaml") << layout << "jitter: bad.txt\n";
+    try {
+      Dataset::open(root / "bad.yaml");
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find((root / "bad.txt").string()), std::string::npos) << e.what();
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string all;
+  for (int f = 0; f < frames; ++f) all += "0.25 -0.25\n";
+  EXPECT_NE(open_error("0.25 -0.25\n").find("has 1 offsets for the capture's 8 frames"), std::string::npos);
+  EXPECT_NE(open_error(all + "\n0 0\n").find("line 10: more offsets than the capture's 8 frames"), std::string::npos);
+  EXPECT_NE(open_error("# x y\n0.25\n" + all).find("line 2: expected two numbers 'x y', got '0.25'"), std::string::npos);
+  EXPECT_NE(open_error("0.25 -0.25 1\n" + all).find("line 1: expected two numbers"), std::string::npos);
+  EXPECT_NE(open_error("nan 0\n" + all).find("line 1: expected two numbers"), std::string::npos);
+  EXPECT_NE(open_error("0.5 0\n" + all).find("line 1: offset 0.5000 is outside [-0.5, 0.5) pixels"), std::string::npos);
+  std::ofstream(root / "missing.yaml") << layout << "jitter: missing.txt\n";
+  try {
+    Dataset::open(root / "missing.yaml");
+    ADD_FAILURE() << "opened a capture whose jitter file is missing";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find((root / "missing.txt").string() + ": cannot open the jitter file"), std::string::npos)
+        << e.what();
   }
   fs::remove_all(root);
 }
