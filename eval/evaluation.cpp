@@ -94,8 +94,7 @@ torch::Tensor hr_motion(const Batch& b, const Dataset& data, int frame, size_t l
     if (c == RenderChannel::Motion) return b.hr_info.slice(1, offset, offset + channel_width(c));
     offset += channel_width(c);
   }
-  const auto lr = data.frame(frame, lr_resolution)->motion.unsqueeze(0);
-  return lr.repeat_interleave(scale, 2).repeat_interleave(scale, 3) * static_cast<float>(scale);
+  return upsample_channel(data.frame(frame, lr_resolution)->motion.unsqueeze(0), RenderChannel::Motion, scale);
 }
 
 // The HR edge map of `frame` at the size of `hr_color` (the batch's HR frame, from the cache),

@@ -98,10 +98,11 @@ std::string history_missing_at(const DatasetInfo& info, size_t resolution) {
   const auto& at = info.stored_at.empty() ? info.stored : info.stored_at[resolution];
   const auto& lr = info.stored_at.empty() ? info.stored : info.stored_at.front();
   auto has = [](const std::vector<RenderChannel>& v, RenderChannel c) { return std::find(v.begin(), v.end(), c) != v.end(); };
+  // Motion and depth at r, or at LR to upsample (resolve_history); and LR depth for the samples.
   std::vector<std::string> missing;
-  if (!has(at, RenderChannel::Motion)) missing.push_back("motion at " + r.name());
-  if (!has(at, RenderChannel::Depth)) missing.push_back("depth at " + r.name());
-  if (resolution != 0 && !has(lr, RenderChannel::Depth)) missing.push_back("depth at " + info.resolutions.front().name());
+  const std::string or_lr = resolution == 0 ? "" : " or " + info.resolutions.front().name();
+  if (!has(at, RenderChannel::Motion) && !has(lr, RenderChannel::Motion)) missing.push_back("motion at " + r.name() + or_lr);
+  if (!has(lr, RenderChannel::Depth)) missing.push_back("depth at " + info.resolutions.front().name());
   return missing.empty() ? std::string() : "the data set has no " + join(missing, " and no ");
 }
 
@@ -338,6 +339,22 @@ struct Dataset::Impl {
     return f;
   }
 
+  // Frame `frame`'s depth and motion at resolution `res`: as stored there, or, for a capture that
+  // stores them at the render size only, the LR ones upsampled as an engine passes them.
+  Frame depth_and_motion(int frame, size_t res) const {
+    const auto& here = info.stored_at[res];
+    std::vector<RenderChannel> stored_here, from_lr;
+    for (auto c : {RenderChannel::Depth, RenderChannel::Motion})
+      (std::find(here.begin(), here.end(), c) != here.end() ? stored_here : from_lr).push_back(c);
+    Frame out = stored_here.empty() ? Frame() : source->load(frame, res, stored_here);
+    if (from_lr.empty()) return out;
+    const Frame lr = source->load(frame, 0, from_lr);
+    const int scale = lr_multiple(info, res);
+    if (!out.depth.defined()) out.depth = upsample_channel(lr.depth, RenderChannel::Depth, scale);
+    if (!out.motion.defined()) out.motion = upsample_channel(lr.motion, RenderChannel::Motion, scale);
+    return out;
+  }
+
   // The history channel of frame `index` at resolution `res`: the frame and up to kHistoryFrames
   // predecessors of its scene, their stored channels read from the source (never through the cache:
   // a cached frame would derive its own history, K frames deeper each time).
@@ -353,7 +370,7 @@ struct Dataset::Impl {
       if (k == 0 && f.depth.defined() && f.motion.defined())
         at_r = f;
       else if (link)
-        at_r = source->load(frame, res, {RenderChannel::Depth, RenderChannel::Motion});
+        at_r = depth_and_motion(frame, res);
       h.depth = at_r.depth;
       h.motion = at_r.motion;
       const Frame lr = res == 0 && at_r.color.defined() ? at_r : source->load(frame, 0, {RenderChannel::Depth});

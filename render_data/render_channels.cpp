@@ -38,6 +38,11 @@ const std::vector<RenderChannel>& all_render_channels() {
 const std::string& channel_name(RenderChannel channel) { return info(channel).name; }
 int channel_width(RenderChannel channel) { return info(channel).width; }
 
+torch::Tensor upsample_channel(const torch::Tensor& t, RenderChannel channel, int scale) {
+  const auto nearest = t.repeat_interleave(scale, -2).repeat_interleave(scale, -1);
+  return channel == RenderChannel::Motion ? nearest * static_cast<float>(scale) : nearest;
+}
+
 RenderChannel channel_from_name(const std::string& name) {
   std::vector<std::string> names;
   for (const auto& i : table()) {

@@ -43,8 +43,8 @@
 //                                 1 - k/(K+1) for frame t-k's, 0 where none lands (colour 0); the
 //                                 most recent sample wins. Derived on load (history_channel.h) only
 //                                 when asked for by name, at every integer multiple of the LR
-//                                 resolution where motion and depth are stored (and LR depth);
-//                                 docs/temporal.md
+//                                 resolution, from LR depth and the depth and motion stored
+//                                 there or at LR (upsampled: upsample_channel); docs/temporal.md
 //   jitter          2    pixels   the LR frame's sub-pixel jitter (jitter.h), (x, y) in LR pixels
 //                                 (x right, y down, each in [-0.5, 0.5)), the same at every pixel
 //                                 and at every resolution: what an engine passes a temporal
@@ -71,6 +71,11 @@ int total_width(const std::vector<RenderChannel>& channels);
 // Names <-> channels, sorted into the fixed order; duplicates are an error.
 std::vector<RenderChannel> parse_channels(const std::vector<std::string>& names);
 std::vector<std::string> channel_names(const std::vector<RenderChannel>& channels);
+
+// A channel stored at the render (LR) size, at `scale` times that size the way an engine passes
+// it to a pass at the output size: nearest (each LR pixel over its s x s block), and motion also
+// times s (pixels of the larger resolution). `t` is [..., h, w].
+torch::Tensor upsample_channel(const torch::Tensor& t, RenderChannel channel, int scale);
 
 // The rows of `info` ([N, total_width(available), H, W], channels stacked in `available` order)
 // that hold `wanted`, in `wanted` order. Errors name the tensor (`what`, e.g. "lr_info") and who
