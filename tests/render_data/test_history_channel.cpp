@@ -1,7 +1,9 @@
 // The `history` rendering channel (history_channel.h): zero-upsampling places each jittered LR
 // sample at the point it sampled, warping through motion reproduces the frame better than
 // bicubic and the depth test rejects disoccluded samples, the history resets at a scene cut, loads
-// are deterministic, data without motion is a clear error, and a network reading it trains.
+// are deterministic, data without motion is a clear error, a jittered game capture gives the same
+// history (its jitter from a file; depth and motion at LR only are upsampled), and a network
+// reading it trains.
 // Real frames of the tiny scene (configs/scenes/tiny.yaml), rendered once per process.
 #include <gtest/gtest.h>
 
@@ -303,7 +305,8 @@ TEST(HistoryChannel, AJitteredCaptureWithItsJitterFileGivesTheRenderedHistory) {
       const std::string n = std::to_string(f);
       write_image(root / dir / ("color_" + n + ".png"), fr.color_float());
       write_image(root / dir / ("depth_" + n + ".exr"), torch::where(torch::isinf(fr.depth), torch::zeros({}), fr.depth), {32});
-      write_image(root / dir / ("mv_" + n + ".exr"), torch::cat({fr.motion.to(torch::kFloat32), torch::zeros({1, fr.height, fr.width})}), {32});
+      const auto motion = torch::cat({fr.motion.to(torch::kFloat32), torch::zeros({1, fr.height, fr.width})});
+      write_image(root / dir / ("mv_" + n + ".exr"), motion, {32});
       if (res == 0) jitter << fr.jitter[0] << " " << fr.jitter[1] << "\n";
     }
   }
