@@ -3,6 +3,7 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <fstream>
 #include <iterator>
@@ -72,6 +73,8 @@ bool natural_less(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j;
 }
 
+namespace {
+// The jitter file's offsets, one per frame; throws cgsr::Error naming the file and line.
 std::vector<std::array<double, 2>> read_jitter_file(const fs::path& path, int frames) {
   std::ifstream in(path);
   if (!in) throw Error(path.string(), "cannot open the jitter file");
@@ -99,7 +102,6 @@ std::vector<std::array<double, 2>> read_jitter_file(const fs::path& path, int fr
   return offsets;
 }
 
-namespace {
 bool wildcard_match(const char* p, const char* s) {
   // Iterative matcher with backtracking on the last '*'.
   const char *star = nullptr, *resume = nullptr;

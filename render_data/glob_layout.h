@@ -32,7 +32,6 @@
 // pixels in [-0.5, 0.5), the content at p + offset: render_data/jitter.h); blank lines and lines
 // starting with '#' are skipped.
 
-#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -65,7 +64,5 @@ config::Schema<GlobLayoutOptions> glob_layout_schema();
 std::vector<std::filesystem::path> glob_files(const std::filesystem::path& base, const std::string& pattern);
 // "frame2" < "frame10".
 bool natural_less(const std::string& a, const std::string& b);
-// The jitter file's offsets, one per frame; throws cgsr::Error naming the file and line.
-std::vector<std::array<double, 2>> read_jitter_file(const std::filesystem::path& path, int frames);
 
 }  // namespace cgsr
