@@ -340,15 +340,16 @@ struct Dataset::Impl {
   }
 
   // Frame `frame`'s depth and motion at resolution `res`: as stored there, or, for a capture that
-  // stores them at the render size only, the LR ones upsampled as an engine passes them.
-  Frame depth_and_motion(int frame, size_t res) const {
+  // stores them at the render size only, the LR ones upsampled as an engine passes them. The LR
+  // frame read for that (with its depth) is left in `lr`, so the samples need not read it again.
+  Frame depth_and_motion(int frame, size_t res, Frame& lr) const {
     const auto& here = info.stored_at[res];
     std::vector<RenderChannel> stored_here, from_lr;
     for (auto c : {RenderChannel::Depth, RenderChannel::Motion})
       (std::find(here.begin(), here.end(), c) != here.end() ? stored_here : from_lr).push_back(c);
     Frame out = stored_here.empty() ? Frame() : source->load(frame, res, stored_here);
     if (from_lr.empty()) return out;
-    const Frame lr = source->load(frame, 0, from_lr);
+    lr = source->load(frame, 0, {RenderChannel::Depth, RenderChannel::Motion});
     const int scale = lr_multiple(info, res);
     if (!out.depth.defined()) out.depth = upsample_channel(lr.depth, RenderChannel::Depth, scale);
     if (!out.motion.defined()) out.motion = upsample_channel(lr.motion, RenderChannel::Motion, scale);
@@ -366,14 +367,14 @@ struct Dataset::Impl {
       HistoryFrame h;
       // Motion and depth at r link the chain; the oldest frame only gives its LR samples.
       const bool link = k < kHistoryFrames;
-      Frame at_r;
+      Frame at_r, lr;
       if (k == 0 && f.depth.defined() && f.motion.defined())
         at_r = f;
       else if (link)
-        at_r = depth_and_motion(frame, res);
+        at_r = depth_and_motion(frame, res, lr);
       h.depth = at_r.depth;
       h.motion = at_r.motion;
-      const Frame lr = res == 0 && at_r.color.defined() ? at_r : source->load(frame, 0, {RenderChannel::Depth});
+      if (!lr.color.defined()) lr = res == 0 && at_r.color.defined() ? at_r : source->load(frame, 0, {RenderChannel::Depth});
       h.lr_color = lr.color;
       h.lr_depth = lr.depth;
       h.jitter = lr.jitter;
