@@ -84,6 +84,20 @@ std::pair<int, int> parse_size(const std::string& text, const std::string& what)
   return {w, h};
 }
 
+std::optional<std::pair<int, int>> parse_frame_range(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  try {
+    size_t used_a = 0, used_b = 0;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    const int first = std::stoi(a, &used_a), end = std::stoi(b, &used_b);
+    if (used_a != a.size() || used_b != b.size() || first < 0 || end <= first) return std::nullopt;
+    return std::pair{first, end};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
 std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "NA";
   std::ostringstream s;

@@ -1,7 +1,9 @@
 #pragma once
 // Small string helpers shared by config validation, registries and the CLI.
 
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cgsr {
@@ -23,6 +25,9 @@ std::vector<std::string> split(const std::string& text, char separator);
 
 // Parses "WxH" (e.g. "320x240") into width and height; throws cgsr::Error naming `what`.
 std::pair<int, int> parse_size(const std::string& text, const std::string& what);
+
+// Parses a frame range "A:B" (A included, B not, whole numbers 0 <= A < B); nothing when malformed.
+std::optional<std::pair<int, int>> parse_frame_range(const std::string& text);
 
 // `v` with `digits` decimals ("25.412"); "NA" when not finite.
 std::string fixed(double v, int digits);

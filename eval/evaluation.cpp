@@ -11,15 +11,12 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/progress.h"
+#include "core/text.h"
 #include "eval/temporal.h"
 #include "render_data/edges.h"
 #include "render_data/patch_sampler.h"
 
 namespace cgsr {
-
-namespace {
-std::optional<std::pair<int, int>> parse_frame_range(const std::string& text);
-}  // namespace
 
 config::Schema<EvalOptions> eval_schema_fields() {
   config::Schema<EvalOptions> s;
@@ -35,22 +32,6 @@ config::Schema<EvalOptions> eval_schema_fields() {
   s.field("save_frames", &EvalOptions::save_frames, "directory for the upscaled frames (PNG); empty = none");
   return s;
 }
-
-namespace {
-std::optional<std::pair<int, int>> parse_frame_range(const std::string& text) {
-  const auto colon = text.find(':');
-  if (colon == std::string::npos) return std::nullopt;
-  try {
-    size_t used_a = 0, used_b = 0;
-    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-    const int first = std::stoi(a, &used_a), end = std::stoi(b, &used_b);
-    if (used_a != a.size() || used_b != b.size() || first < 0 || end <= first) return std::nullopt;
-    return std::pair{first, end};
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-}  // namespace
 
 std::vector<int> evaluation_frames(const Dataset& data, const EvalOptions& options) {
   std::vector<int> frames = data.frames(split_from_name(options.split));
