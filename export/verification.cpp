@@ -56,10 +56,12 @@ NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch) {
 }
 
 void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,
-                       const ReferenceForward& forward) {
+                       const ReferenceForward& forward, const std::string& name) {
   const auto signature = export_signature(net.describe(false));
   check_inputs(signature, inputs);
   c.inputs.push_back(inputs);
+  c.input_names.resize(c.inputs.size() - 1);
+  c.input_names.push_back(name);
   const torch::Tensor color = find_tensor(inputs, kExportColorInput), info = info_tensor(signature, inputs);
   c.expected.push_back(forward ? forward(color, info) : infer(net, color, info));
 }
@@ -130,12 +132,13 @@ VerifyReport verify_exports(const std::vector<VerifyCase>& cases, const VerifyOp
       if (!why.empty() && explicit_runtimes)
         throw Error(c.file.string(), std::string("cannot verify in ") + runtime_name(runtime) + ": " + why);
       slots.push_back({ci, runtime, report.checks.size()});
-      for (const auto& inputs : c.inputs) {
+      for (size_t i = 0; i < c.inputs.size(); ++i) {
         RuntimeCheck check;
         check.label = c.label;
         check.file = c.file;
         check.runtime = runtime;
-        check.input = size_of(inputs);
+        const std::string name = i < c.input_names.size() ? c.input_names[i] : "";
+        check.input = name.empty() ? size_of(c.inputs[i]) : name + " (" + size_of(c.inputs[i]) + ")";
         check.skipped = why;
         report.checks.push_back(check);
       }
@@ -236,10 +239,13 @@ int VerifyReport::failed() const { return static_cast<int>(checks.size()) - pass
 std::string VerifyReport::table() const {
   std::string out;
   char line[512];
-  size_t label_width = 5;
-  for (const auto& c : checks) label_width = std::max(label_width, c.label.size());
-  const int lw = static_cast<int>(label_width);
-  std::snprintf(line, sizeof line, "%-*s  %-13s %-9s %-12s %s\n", lw, "model", "runtime", "input", "max |error|",
+  size_t label_width = 5, input_width = 9;
+  for (const auto& c : checks) {
+    label_width = std::max(label_width, c.label.size());
+    input_width = std::max(input_width, c.input.size());
+  }
+  const int lw = static_cast<int>(label_width), iw = static_cast<int>(input_width);
+  std::snprintf(line, sizeof line, "%-*s  %-13s %-*s %-12s %s\n", lw, "model", "runtime", iw, "input", "max |error|",
                 "result");
   out += line;
   for (const auto& c : checks) {
@@ -254,7 +260,7 @@ std::string VerifyReport::table() const {
       error = e;
       result = c.passed ? "ok" : "FAILED (tolerance " + std::to_string(tolerance) + ")" + (c.error.empty() ? "" : ": " + c.error);
     }
-    std::snprintf(line, sizeof line, "%-*s  %-13s %-9s %-12s ", lw, c.label.c_str(), runtime_name(c.runtime),
+    std::snprintf(line, sizeof line, "%-*s  %-13s %-*s %-12s ", lw, c.label.c_str(), runtime_name(c.runtime), iw,
                   c.input.c_str(), error.c_str());
     out += line + result + "\n";
   }

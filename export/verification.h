@@ -36,6 +36,7 @@ struct VerifyCase {
   ExportFormat format = ExportFormat::Onnx;
   std::vector<NamedTensors> inputs;     // one or more input sets
   std::vector<torch::Tensor> expected;  // our forward pass on each input set
+  std::vector<std::string> input_names; // each set's name in reports ("frame 12"; "" for random inputs)
 };
 
 // Our side of a comparison: the network's output for LR colour and rendering information.
@@ -52,9 +53,9 @@ VerifyCase make_verify_case(SRNetworkImpl& net, const ExportedModel& exported,
 // rendering channels at the resolution it wants (SRNetworkImpl::info_input).
 NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch);
 
-// Adds an input set (e.g. a rendered frame) with our forward pass on it.
+// Adds an input set (e.g. a rendered frame, named "frame 12") with our forward pass on it.
 void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,
-                       const ReferenceForward& forward = {});
+                       const ReferenceForward& forward = {}, const std::string& name = "");
 
 struct VerifyOptions {
   // Empty: every runtime of each file's format; one that cannot run a file (OpenCV DNN on a
@@ -69,7 +70,7 @@ struct RuntimeCheck {
   std::string label;
   std::filesystem::path file;
   Runtime runtime = Runtime::OnnxRuntime;
-  std::string input;    // "12x10"
+  std::string input;    // "12x10", or "frame 12 (64x48)" for a named input set
   bool ran = false;
   std::string skipped;  // why it did not run
   std::string error;    // the runtime's message when it failed on the file
