@@ -279,8 +279,9 @@ TEST(Rit, BspCompositeIsTheBspImageWhereCoveredAndTheNetworkElsewhere) {
       // A loss on the covered pixels only reaches no parameter.
       net->zero_grad();
       net->forward_train(color, info).image.masked_select(covered).sum().backward();
-      for (const auto& p : net->parameters())
+      for (const auto& p : net->parameters()) {
         if (p.grad().defined()) EXPECT_EQ(p.grad().abs().max().item<float>(), 0.f);
+      }
       // The composite holds no parameters: the model file and the parameter count are unchanged.
       EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));
       EXPECT_EQ(inference_parameter_count(*net), inference_parameter_count(*plain));
