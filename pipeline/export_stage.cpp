@@ -38,14 +38,21 @@ config::Schema<ExportCommandOptions> export_schema() {
   s.field("out", &ExportCommandOptions::out, "the file to write (a directory for a hybrid-pruned model)").required();
   s.field("precision", &ExportCommandOptions::precision,
           "fp32, or int8: ONNX with QuantizeLinear/DequantizeLinear around the convolutions, calibrated on data");
-  s.field("data", &ExportCommandOptions::data, "int8: data set whose rendered frames calibrate the activations");
+  s.field("data", &ExportCommandOptions::data,
+          "data set whose rendered frames calibrate int8's activations and, with verify, verify the file");
+  s.field("frames", &ExportCommandOptions::frames,
+          "verify: frame range A:B of data (A included, B not) run in order; empty = the first test frame")
+      .check([](const std::string& v) { return v.empty() || parse_frame_range(v).has_value(); },
+             "must be A:B with whole numbers 0 <= A < B");
   s.section("calibration", &ExportCommandOptions::calibration, calibration_schema_fields(),
             "int8: the frames activation ranges are measured on");
   s.field("int8_tolerance", &ExportCommandOptions::int8_tolerance,
           "int8: max abs error allowed by verify against the fused path's int8 output")
       .range(0, 1);
   const auto fp32 = [](const ExportCommandOptions& o) { return o.precision == Precision::Fp32; };
-  for (const char* key : {"precision", "data", "calibration", "int8_tolerance"}) s.omit_when(key, fp32);
+  for (const char* key : {"precision", "calibration", "int8_tolerance"}) s.omit_when(key, fp32);
+  s.omit_when("data", [](const ExportCommandOptions& o) { return o.data.empty(); });
+  s.omit_when("frames", [](const ExportCommandOptions& o) { return o.frames.empty(); });
   s.validate([](const ExportCommandOptions& o, const config::Cursor& at, const YAML::Node& node) {
     parse_size(o.input, "input");
     if (o.dynamic_size && o.format != ExportFormat::Onnx)
@@ -56,6 +63,8 @@ config::Schema<ExportCommandOptions> export_schema() {
       at.child("precision").fail(node, "int8 is exported as ONNX (format: onnx)");
     if (o.precision == Precision::Int8 && o.data.empty())
       at.child("data").fail(node, "int8 needs a data set to calibrate its activations on (--data DIR)");
+    if (!o.frames.empty() && (o.data.empty() || !o.verify))
+      at.child("frames").fail(node, "frames are verified on: give --verify and the data set (--data DIR)");
   });
   add_run_settings(s);
   return s;
@@ -129,6 +138,23 @@ nlohmann::ordered_json run_hybrid_export(const ExportCommandOptions& options, co
   return results;
 }
 
+// The frames of `data` that verify a file: `range` in order (a sequence keeps its history, reset
+// at scene cuts, as the data set derives it), or the first test frame.
+std::vector<int> verification_frames(const Dataset& data, const std::string& range) {
+  if (range.empty()) {
+    const std::vector<int> test = data.frames(Split::Test);
+    return {test.empty() ? 0 : test.front()};
+  }
+  const auto [first, end] = *parse_frame_range(range);
+  const int n = data.frame_count();
+  if (end > n)
+    throw Error(data.info().root.string(), "frames " + range + ": the data set has " + std::to_string(n) +
+                                               " frames (0:" + std::to_string(n) + ")");
+  std::vector<int> frames;
+  for (int f = first; f < end; ++f) frames.push_back(f);
+  return frames;
+}
+
 }  // namespace
 
 nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
@@ -142,15 +168,16 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   ModelSource source = resolve_model(options.model, options.scale);
   if (source.provenance && is_hybrid_model(*source.provenance)) {
     if (options.precision != Precision::Fp32) throw Error(options.model, "a hybrid-pruned model exports in fp32 only");
+    if (!options.frames.empty())
+      throw Error(options.model, "a hybrid-pruned model verifies on random inputs and sampler frames, not on --frames");
     return run_hybrid_export(options, o);
   }
   SRNetwork net = source.network;
   net->eval();
   std::optional<Dataset> data;
-  if (options.precision == Precision::Int8) {
+  if (!options.data.empty() && (options.precision == Precision::Int8 || options.verify))
     data = open_for_channels(options.data, net->input_channels());
-    o.int8 = calibrate_network(*net, *data, options.calibration);
-  }
+  if (options.precision == Precision::Int8) o.int8 = calibrate_network(*net, *data, options.calibration);
   const ExportedModel exported = export_network(*net, options.out, o);
 
   nlohmann::ordered_json results;
@@ -196,10 +223,18 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   }
   VerifyCase c = make_verify_case(*net, exported, sizes, seed, forward);
   if (data) {
-    const std::vector<int> frames = data->frames(Split::Test);
-    const int frame = frames.empty() ? 0 : frames.front();
-    const Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
-    if (b.lr_color.size(3) == w && b.lr_color.size(2) == h) add_verify_inputs(c, *net, inputs_from_batch(*net, b), forward);
+    for (int frame : verification_frames(*data, options.frames)) {
+      const Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
+      const int64_t fw = b.lr_color.size(3), fh = b.lr_color.size(2);
+      if (!exported.dynamic_size && (fw != w || fh != h)) {
+        // The first test frame is a bonus check; frames asked for must run.
+        if (options.frames.empty()) break;
+        throw Error(options.data, "frame " + std::to_string(frame) + " is " + std::to_string(fw) + "x" +
+                                      std::to_string(fh) + " at LR, the file takes " + options.input +
+                                      " (--input, or --dynamic-size)");
+      }
+      add_verify_inputs(c, *net, inputs_from_batch(*net, b), forward, "frame " + std::to_string(frame));
+    }
   }
   const VerifyReport report = verify_exports({c}, v);
   results["verification"] = report.to_json();

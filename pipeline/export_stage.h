@@ -5,6 +5,7 @@
 //
 //   cgsr export --model pan --scale 2 --format onnx --input 320x240 --out pan_x2.onnx --verify
 //   cgsr export --model runs/train/model.cgsr --format torchscript --out model.pt
+//   cgsr export --model runs/train/model.cgsr --input 320x240 --verify --data DIR --frames 40:48
 //
 // `out` names the exported file (the job writes no run directory). A hybrid-pruned model
 // file (pruning/hybrid_model.h) exports as a directory instead: `out` DIR gets one file per
@@ -31,7 +32,10 @@ struct ExportCommandOptions : RunSettings {
   double tolerance = 1e-4;        // max abs error allowed by --verify
   std::string out;                // the file to write
   Precision precision = Precision::Fp32;  // int8: a quantized (QDQ) ONNX file, calibrated on `data`
-  std::string data;                       // int8: the rendered frames the activations are calibrated on
+  // The rendered frames int8 calibrates its activations on; with `verify`, frames that verify the
+  // file besides the random inputs: `frames` in order, or the first test frame.
+  std::string data;
+  std::string frames;  // "A:B": frames A <= i < B of `data`, every split (a sequence, scene cuts included)
   CalibrationOptions calibration;
   // int8: --verify compares with the fused path's int8 run, whose convolutions keep their
   // results in float32 until they are stored, where ONNX Runtime's round each to int8.

@@ -19,7 +19,8 @@ void setup_export(CLI::App& app) {
         flag_to_key(sub, flags, "--tolerance", "tolerance", "max abs error allowed by --verify");
         flag_to_key(sub, flags, "--out", "out", "the file to write (a directory for a hybrid-pruned model)");
         flag_to_key(sub, flags, "--precision", "precision", "fp32, or int8 (quantized ONNX, calibrated on --data)");
-        flag_to_key(sub, flags, "--data", "data", "int8: data set whose frames calibrate the activations");
+        flag_to_key(sub, flags, "--data", "data", "data set whose frames calibrate int8 and, with --verify, verify the file");
+        flag_to_key(sub, flags, "--frames", "frames", "--verify: frames A:B of --data, run in order (default: the first test frame)");
       },
       [](const ExportCommandOptions& options, const YAML::Node&, RunDir*) { return run_export(options); },
       /*always_run_dir=*/false);
