@@ -112,7 +112,9 @@ TEST(Int8Export, ConvolutionsReadQuantizedInputsAndInt8WeightsExceptTheWideOnes)
     EXPECT_EQ(producer.at(from(0)->input(0))->op_type(), "QuantizeLinear");
     EXPECT_EQ(initializers.at(from(1)->input(0))->data_type(), onnx::TensorProto::INT8);
     EXPECT_EQ(initializers.at(from(1)->input(1))->dims(0), op.weight.size(0));
-    if (conv->input_size() > 2) EXPECT_EQ(initializers.at(from(2)->input(0))->data_type(), onnx::TensorProto::INT32);
+    if (conv->input_size() > 2) {
+      EXPECT_EQ(initializers.at(from(2)->input(0))->data_type(), onnx::TensorProto::INT32);
+    }
     // Its result is quantized again.
     int consumers = 0;
     for (const auto& n : e.model.graph().node())

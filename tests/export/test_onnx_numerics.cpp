@@ -46,7 +46,7 @@ class OnnxNumerics {
     o.width = width;
     o.height = height;
     const ExportedModel m = export_network(*e.net, dir_ / ("m" + std::to_string(cases_.size()) + ".onnx"), o);
-    cases_.push_back({label, m.file, m.format, {}, {}});
+    cases_.push_back({label, m.file, m.format, {}, {}, {}});
     signatures_.push_back(m.signature);
   }
 

@@ -206,7 +206,7 @@ TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
       EXPECT_EQ(e.context(), "arch spec: " + key);
     }
   }
-  for (const std::string& other : {"backbone: edsr", "backbone: pan\nimage_skip: bicubic"}) {
+  for (const std::string& other : std::vector<std::string>{"backbone: edsr", "backbone: pan\nimage_skip: bicubic"}) {
     const std::string error = parse_error(other + "\nrit: {enabled: true, channels: [jitter], source: hr_fuse, skip_at_jitter: true}\n");
     EXPECT_NE(error.find("rit.skip_at_jitter"), std::string::npos) << error;
     EXPECT_NE(error.find(other == "backbone: edsr" ? "adds no interpolated image" : "image_skip is bicubic"), std::string::npos)

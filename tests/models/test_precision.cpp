@@ -122,8 +122,11 @@ TEST(Precision, WideLayersStayFloat32) {
     EXPECT_EQ(precision_of("backbone.conv_last"), "fp32");
     EXPECT_EQ(precision_of("backbone.blocks.0.pa_conv.k3"), low);
     EXPECT_EQ(precision_of("backbone.trunk_conv"), low);
-    for (const auto& op : g.ops)
-      if (op.kind == graph::OpKind::Conv && op.inputs[0] == g.input("info")) EXPECT_EQ(precision_of(op.name), "fp32");
+    for (const auto& op : g.ops) {
+      if (op.kind == graph::OpKind::Conv && op.inputs[0] == g.input("info")) {
+        EXPECT_EQ(precision_of(op.name), "fp32");
+      }
+    }
     int converted = 0;
     for (const auto& s : fused.steps()) {
       converted += s.kind == "convert";
@@ -131,7 +134,9 @@ TEST(Precision, WideLayersStayFloat32) {
     }
     EXPECT_GT(converted, 0);  // the float32 residuals are converted once for their readers
   }
-  EXPECT_THROW(FusedGraph(g, {.precision = Precision::Int8}), Error);  // no calibration
+  FusedGraph::Options uncalibrated;
+  uncalibrated.precision = Precision::Int8;
+  EXPECT_THROW(FusedGraph(g, uncalibrated), Error);  // no calibration
   // Which convolutions compute low can be given (the latency table times a lone one so): the
   // first layer too; marking an op that is not a convolution, or a list of another length, is an error.
   FusedGraph::Options first;
@@ -162,7 +167,10 @@ TEST(Precision, SimulatedInt8MatchesTheFusedPathAndPassesGradients) {
   const graph::Graph g = net->describe();
   const Inputs calibration_frame = frame_inputs(g, 12, 16, 3), in = frame_inputs(g, 12, 16, 4);
   const Calibration c = calibrate(g, {calibration_frame}, CalibrationMethod::Max);
-  FusedGraph int8(g, {.precision = Precision::Int8, .calibration = c});
+  FusedGraph::Options int8_options;
+  int8_options.precision = Precision::Int8;
+  int8_options.calibration = c;
+  FusedGraph int8(g, int8_options);
   const torch::Tensor fused = int8.run(in).front().second;
   const torch::Tensor fp32 = graph::run(g, in).front().second;
   const torch::Tensor simulated = run_fake_int8(g, in, c).front().second;

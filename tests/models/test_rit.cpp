@@ -280,7 +280,9 @@ TEST(Rit, BspCompositeIsTheBspImageWhereCoveredAndTheNetworkElsewhere) {
       net->zero_grad();
       net->forward_train(color, info).image.masked_select(covered).sum().backward();
       for (const auto& p : net->parameters()) {
-        if (p.grad().defined()) EXPECT_EQ(p.grad().abs().max().item<float>(), 0.f);
+        if (p.grad().defined()) {
+          EXPECT_EQ(p.grad().abs().max().item<float>(), 0.f);
+        }
       }
       // The composite holds no parameters: the model file and the parameter count are unchanged.
       EXPECT_EQ(total_parameter_count(*net), total_parameter_count(*plain));

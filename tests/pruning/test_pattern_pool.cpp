@@ -54,8 +54,9 @@ TEST(PatternPool, TheUnionHoldsEveryPatternAndRebasedPatternsComputeTheSame) {
       for (int b : p.blocks) EXPECT_TRUE(std::binary_search(all.blocks.begin(), all.blocks.end(), b));
       for (const auto& [group, width] : p.widths) {
         const auto block = parse_block_group(group);
-        if (!block || std::binary_search(p.blocks.begin(), p.blocks.end(), block->first))
+        if (!block || std::binary_search(p.blocks.begin(), p.blocks.end(), block->first)) {
           EXPECT_LE(width, all.widths.at(group)) << group;
+        }
       }
     }
     SRNetwork small = materialize_subnet(*net, all, false);

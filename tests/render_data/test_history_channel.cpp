@@ -356,7 +356,7 @@ TEST(HistoryChannel, AJitteredCaptureWithItsJitterFileGivesTheRenderedHistory) {
       " --set enhance.geometry.enabled=false --out " + (root / "train").string());
   ASSERT_EQ(train.exit_code, 0) << train.all();
   const fs::path data[3] = {jittered_data(), root / "capture.yaml", root / "lr_only.yaml"};
-  for (const std::string model : {std::string("history"), (root / "train" / "model.cgsr").string()}) {
+  for (const std::string& model : {std::string("history"), (root / "train" / "model.cgsr").string()}) {
     SCOPED_TRACE(model);
     double psnr[3];
     for (int i = 0; i < 3; ++i) {
