@@ -11,6 +11,7 @@
 #include "models/importance/channel_importance.h"
 #include "models/subnet.h"
 #include "tests/models/model_cases.h"
+#include "tests/support/elastic_options.h"
 
 namespace cgsr {
 namespace {
@@ -89,7 +90,7 @@ TEST(Subnet, EqualsTheFullNetworkWithDroppedChannelsAndBlocksMasked) {
   for (const ArchSpec& spec : {small_pan(2), small_pan(4), small_edsr(), small_span()}) {
     SCOPED_TRACE(spec_summary(spec));
     const SRNetwork net = test::build_network(spec, 3);
-    const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+    const ElasticSpace space(spec, test::elastic_options(4, 0.25, 1));
     std::mt19937_64 rng(7);
     const auto [color, info] = test::random_inputs(spec, 9, 7);
     for (int i = 0; i < 6; ++i) {
@@ -142,7 +143,7 @@ TEST(Subnet, MaterializedSubnetComputesTheSameAsItsGraph) {
   for (const ArchSpec& spec : {small_pan(), small_span()}) {
     SCOPED_TRACE(spec_summary(spec));
     const SRNetwork net = test::build_network(spec, 4);
-    const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+    const ElasticSpace space(spec, test::elastic_options(4, 0.25, 2));
     std::mt19937_64 rng(11);
     const auto [color, info] = test::random_inputs(spec, 10, 6);
     for (int i = 0; i < 4; ++i) {
@@ -161,7 +162,7 @@ TEST(Subnet, MaterializedSubnetComputesTheSameAsItsGraph) {
 
 TEST(ElasticSpace, EverySubnetKeepsTheBackbonesFixedBlocks) {
   const ArchSpec spec = small_span();  // conv_cat reads SPAN's first block and inside its last
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 1));
   EXPECT_EQ(space.min_blocks(), 2);
   EXPECT_EQ(space.smallest().blocks, (std::vector<int>{0, 2}));
   std::mt19937_64 rng(5);
@@ -215,7 +216,7 @@ TEST(Subnet, ProblemsAndJsonRoundTrip) {
 
 TEST(ElasticSpace, ChoicesSamplesAndRepair) {
   const ArchSpec spec = small_pan();
-  const ElasticSpace space(spec, ElasticOptions{4, 0.5, 2}, {3, 1, 0, 2});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.5, 2), {3, 1, 0, 2});
   for (const auto& gene : space.genes()) {
     EXPECT_EQ(gene.choices.back(), gene.full) << gene.group;
     EXPECT_GE(gene.choices.front() * 2, gene.full) << gene.group;
@@ -242,7 +243,7 @@ TEST(ElasticSpace, ChoicesSamplesAndRepair) {
 }
 
 TEST(ElasticSpace, PrecisionIsAGeneWhenTheOptionsListSeveral) {
-  ElasticOptions options{4, 0.5, 2};
+  ElasticOptions options = test::elastic_options(4, 0.5, 2);
   options.precisions = {Precision::Fp32, Precision::Int8};
   const ElasticSpace space(small_pan(), options);
   EXPECT_EQ(space.full().precision, Precision::Fp32);
@@ -256,7 +257,7 @@ TEST(ElasticSpace, PrecisionIsAGeneWhenTheOptionsListSeveral) {
   }
   EXPECT_EQ(drawn.size(), 2u);
   // Training draws the same subnets as without the option: structure only, in float32.
-  const ElasticSpace plain(small_pan(), ElasticOptions{4, 0.5, 2});
+  const ElasticSpace plain(small_pan(), test::elastic_options(4, 0.5, 2));
   std::mt19937_64 a(3), b(3);
   for (int i = 0; i < 10; ++i) EXPECT_EQ(space.sample(a), plain.sample(b));
   // A precision the space does not list is outside it; repair gives the first listed.

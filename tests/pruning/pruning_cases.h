@@ -15,10 +15,11 @@
 #include "models/channel_selection.h"
 #include "models/complexity.h"
 #include "models/elastic.h"
-#include "models/subnet.h"
 #include "models/sr_network.h"
+#include "models/subnet.h"
 #include "pruning/pattern_pool.h"
 #include "pruning/prunable_units.h"
+#include "tests/support/elastic_options.h"
 
 namespace cgsr::test {
 
@@ -72,7 +73,7 @@ inline std::pair<torch::Tensor, torch::Tensor> inputs_for(const SRNetworkImpl& n
 
 // `k` random subnets of `net` (quantum 2, at least one block), widest (most MACs) first.
 inline PatternPool random_pool(const SRNetworkImpl& net, int k, uint64_t seed) {
-  const ElasticSpace space(net.spec(), ElasticOptions{2, 0.25, 1});
+  const ElasticSpace space(net.spec(), test::elastic_options(2, 0.25, 1));
   std::mt19937_64 rng(seed);
   std::vector<std::pair<int64_t, SubnetConfig>> drawn;
   std::set<std::string> keys;

@@ -8,6 +8,7 @@
 #include "models/latency_table.h"
 #include "pruning/dynamic_pruning.h"
 #include "tests/pruning/pruning_cases.h"
+#include "tests/support/elastic_options.h"
 #include "tests/support/tiny_data.h"
 
 using namespace cgsr;
@@ -30,7 +31,7 @@ TEST(DynamicPruning, TheFittedChoiceMeetsTheBudgetOnAverage) {
   latency.calibration_subnets = 2;
   latency.check_subnets = 0;
   latency.subnet_runs = 1;
-  const ElasticSpace space(net->spec(), ElasticOptions{2, 0.25, 1});
+  const ElasticSpace space(net->spec(), test::elastic_options(2, 0.25, 1));
   const LatencyTable table = measure_latency_table(*net, space, 32, 24, latency);
   for (const PatternCost cost : {PatternCost::Macs, PatternCost::Predicted}) {
     SCOPED_TRACE(enum_name(cost));

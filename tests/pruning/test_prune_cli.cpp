@@ -10,6 +10,7 @@
 #include "pruning/pruner.h"
 #include "tests/pruning/pruning_cases.h"
 #include "tests/support/cli_runner.h"
+#include "tests/support/elastic_options.h"
 
 using namespace cgsr;
 using namespace cgsr::test;
@@ -25,7 +26,7 @@ void write_elastic_model(const std::filesystem::path& path) {
   SRNetwork net(small_spec("pan", 2, 3, 8, 8, /*rit=*/true));
   randomize(*net);
   net->eval();
-  const ElasticNetwork elastic = make_elastic(*net, ElasticOptions{2, 0.25, 1});
+  const ElasticNetwork elastic = make_elastic(*net, test::elastic_options(2, 0.25, 1));
   LatencyTableOptions latency;
   latency.runs = 1;
   latency.calibration_subnets = 2;

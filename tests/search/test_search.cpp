@@ -18,6 +18,7 @@
 #include "search/genetic_operators.h"
 #include "search/search_loop.h"
 #include "search/subnet_evaluator.h"
+#include "tests/support/elastic_options.h"
 #include "tests/support/tiny_data.h"
 
 using namespace cgsr;
@@ -102,7 +103,7 @@ SearchOptions small_search(const std::string& strategy = "evolution") {
 }  // namespace
 
 TEST(GeneticOperators, StayInsideTheSpace) {
-  const ElasticSpace space(elastic_pan(), ElasticOptions{4, 0.25, 2});
+  const ElasticSpace space(elastic_pan(), test::elastic_options(4, 0.25, 2));
   std::mt19937_64 rng(3);
   std::set<std::string> keys;
   for (int i = 0; i < 200; ++i) {
@@ -120,7 +121,7 @@ TEST(GeneticOperators, StayInsideTheSpace) {
 }
 
 TEST(GeneticOperators, MutateAndCrossPrecisions) {
-  ElasticOptions options{4, 0.25, 2};
+  ElasticOptions options = test::elastic_options(4, 0.25, 2);
   options.precisions = {Precision::Fp32, Precision::Bf16, Precision::Int8};
   const ElasticSpace space(elastic_pan(), options);
   std::mt19937_64 rng(4);
@@ -152,7 +153,7 @@ TEST(Pareto, RanksCrowdingAndHypervolume) {
 
 TEST(SearchLoop, EvolutionScoresEverySubnetOnceAndBuildsAFront) {
   const ArchSpec spec = elastic_pan();
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 2));
   ScoringEvaluator evaluator(spec);
   SearchHistory history(temp_file("evolution.jsonl"), false);
   seed_everything(1);
@@ -200,7 +201,7 @@ TEST(SearchLoop, EvolutionScoresEverySubnetOnceAndBuildsAFront) {
 
 TEST(SearchLoop, EvolutionFindsABetterFrontThanRandomSearchAtAsManyEvaluations) {
   const ArchSpec spec = elastic_pan(6);
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 2));
   ScoringEvaluator evaluator(spec);
   seed_everything(2);
   SearchOptions o = small_search();
@@ -217,7 +218,7 @@ TEST(SearchLoop, EvolutionFindsABetterFrontThanRandomSearchAtAsManyEvaluations) 
 
 TEST(SearchLoop, AResumedSearchReachesTheSameResult) {
   const ArchSpec spec = elastic_pan();
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 2));
   seed_everything(4);
   ScoringEvaluator whole(spec);
   SearchHistory whole_history(temp_file("whole.jsonl"), false);
@@ -243,7 +244,7 @@ TEST(SearchLoop, AResumedSearchReachesTheSameResult) {
 
 TEST(SearchLoop, AFailingSubnetFollowsTheFailurePolicy) {
   const ArchSpec spec = elastic_pan();
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 2});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 2));
   // Which subnets the first generation proposes: make one of them diverge.
   seed_everything(5);
   std::string victim;
@@ -286,7 +287,7 @@ TEST(InferenceEvaluator, ScoresSubnetsOfARealNetworkOnRenderedCrops) {
   ArchSpec spec = elastic_pan(2);
   SRNetwork net(spec);
   net->eval();
-  const ElasticSpace space(spec, ElasticOptions{4, 0.25, 1});
+  const ElasticSpace space(spec, test::elastic_options(4, 0.25, 1));
   const LatencyTableOptions latency = quick_latency_table();
   const LatencyTable table = measure_latency_table(*net, space, 32, 24, latency);
   const ValidationCropOptions crops = small_crops();
@@ -307,7 +308,7 @@ TEST(InferenceEvaluator, ScoresAnInt8SubnetOnTheFusedPathWithItsOwnLatencyTable)
   ArchSpec spec = elastic_pan(2);
   SRNetwork net(spec);
   net->eval();
-  ElasticOptions options{4, 0.25, 1};
+  ElasticOptions options = test::elastic_options(4, 0.25, 1);
   options.precisions = {Precision::Fp32, Precision::Int8};
   const ElasticSpace space(spec, options);
   const LatencyTableOptions latency = quick_latency_table();

@@ -9,6 +9,7 @@
 #include "models/arch_spec.h"
 #include "models/elastic.h"
 #include "render_data/patch_sampler.h"
+#include "tests/support/elastic_options.h"
 #include "tests/support/tiny_data.h"
 #include "train/distillation.h"
 #include "train/elastic_training.h"
@@ -55,7 +56,7 @@ TEST(ElasticTraining, ShrinkingOpensByPhase) {
 }
 
 TEST(ElasticTraining, StepSubnetsAreAFunctionOfSeedAndStep) {
-  const ElasticSpace space(elastic_pan(), ElasticOptions{4, 0.25, 1});
+  const ElasticSpace space(elastic_pan(), test::elastic_options(4, 0.25, 1));
   ElasticTrainingOptions o;
   o.sampled = 3;
   o.depth = {0, 0};
@@ -78,7 +79,7 @@ TEST(ElasticTraining, SandwichTrainingBringsTheSmallestSubnetTowardTheFull) {
   const Dataset data = Dataset::open(tiny_data());
   SRNetwork trained(elastic_pan());
   Trainer(trained, data, short_schedule(30), LossOptions{}).run();
-  ElasticOptions space_options{4, 0.5, 1};
+  ElasticOptions space_options = test::elastic_options(4, 0.5, 1);
   const ElasticNetwork elastic = make_elastic(*trained, space_options);
   const Batch val = frame_batch(data, data.frames(Split::Val).front(), 2, {}, DepthEncoding::Log);
   const SubnetConfig smallest = elastic.space.smallest();
