@@ -289,6 +289,23 @@ TEST(HistoryChannel, IsDeterministicAndAClearErrorWithoutMotion) {
   fs::remove_all(root);
 }
 
+// Trains PAN x2 with an HR RIT (hr_fuse, width 4) reading `rit` (--set options) for 2 steps on
+// the jittered frames into `out`.
+test::CliResult train_two_steps(const fs::path& out, const std::string& rit) {
+  return test::run_cgsr("train --data " + jittered_data().string() +
+                        " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
+                        " --set schedule.val_frames=1 --set schedule.color_augment=true --set enhance.enabled=true " +
+                        rit + " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4"
+                        " --set enhance.geometry.enabled=false --out " + out.string());
+}
+
+// The best temporal network's RIT options: `channels` (with history and jitter) read, the
+// samples blended, the whole output taken at the jitter.
+std::string output_at_jitter(const std::string& channels) {
+  return "--set 'enhance.rit.channels=" + channels + "' --set enhance.rit.history_blend=true"
+         " --set enhance.rit.skip_at_jitter=true --set enhance.rit.residual_at_jitter=true";
+}
+
 // A jittered sequence as an engine would capture it (the glob layout: PNG colour, float EXR depth
 // and motion at both resolutions) with its jitter in a text file: every frame's jitter and history
 // are the rendered data set's; without the file the frames load unjittered and their history
@@ -347,13 +364,7 @@ TEST(HistoryChannel, AJitteredCaptureWithItsJitterFileGivesTheRenderedHistory) {
   // the rendered frames that reads the history and the jitter (blended, output at the jitter; 2
   // steps). On the jittered capture each gives the rendered data set's PSNR to the last digit;
   // from LR depth and motion within 0.05 dB.
-  const auto train = test::run_cgsr(
-      "train --data " + jittered_data().string() +
-      " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
-      " --set schedule.val_frames=1 --set enhance.enabled=true --set 'enhance.rit.channels=[history, jitter]'"
-      " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4 --set enhance.rit.history_blend=true"
-      " --set enhance.rit.skip_at_jitter=true --set enhance.rit.residual_at_jitter=true"
-      " --set enhance.geometry.enabled=false --out " + (root / "train").string());
+  const auto train = train_two_steps(root / "train", output_at_jitter("[history, jitter]"));
   ASSERT_EQ(train.exit_code, 0) << train.all();
   const fs::path data[3] = {jittered_data(), root / "capture.yaml", root / "lr_only.yaml"};
   for (const std::string& model : {std::string("history"), (root / "train" / "model.cgsr").string()}) {
@@ -420,19 +431,13 @@ TEST(HistoryChannel, ANetworkReadingItTrains) {
   fs::remove_all(dir);
 }
 
-// A PAN x2 network with an HR RIT reading `rit` (--set options) trains 2 steps on the jittered
-// frames and exports to ONNX, `hr_info` the shape of its HR input, and the runtimes reproduce it:
+// A network with `rit` trains 2 steps (train_two_steps) and exports to ONNX, `hr_info` the shape of its HR input, and the runtimes reproduce it:
 // on random inputs and on `verify_frames` (export flags; "": the jittered set's first test frame).
 // Returns the export's output.
 std::string expect_trains_and_exports(const std::string& scratch, const std::string& rit, const std::string& hr_info,
                                       const std::string& verify_frames = "") {
   const auto dir = test::scratch_dir(scratch);
-  const auto train = test::run_cgsr(
-      "train --data " + jittered_data().string() +
-      " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
-      " --set schedule.val_frames=1 --set schedule.color_augment=true --set enhance.enabled=true " + rit +
-      " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4 --set enhance.geometry.enabled=false --out " +
-      (dir / "train").string());
+  const auto train = train_two_steps(dir / "train", rit);
   EXPECT_EQ(train.exit_code, 0) << train.all();
   if (train.exit_code != 0) return "";
   const auto exported = test::run_cgsr(
@@ -465,9 +470,7 @@ TEST(HistoryChannel, ANetworkBlendingItTrainsAndExports) {
 // the network, and ONNX Runtime reproduces it (both GridSamples included; OpenCV DNN has none).
 TEST(HistoryChannel, ANetworkTakingItsOutputAtTheJitterTrainsAndExports) {
   const std::string out =
-      expect_trains_and_exports("output-at-jitter",
-                                "--set 'enhance.rit.channels=[depth, history, jitter]' --set enhance.rit.history_blend=true"
-                                " --set enhance.rit.skip_at_jitter=true --set enhance.rit.residual_at_jitter=true",
+      expect_trains_and_exports("output-at-jitter", output_at_jitter("[depth, history, jitter]"),
                                 "[1, 7, 96, 128]");  // 1 + 4 + 2
   const int first_test = Dataset::open(jittered_data()).frames(Split::Test).at(0);
   EXPECT_TRUE(onnxruntime_passed(out, "frame " + std::to_string(first_test) + " (64x48)")) << out;
@@ -478,11 +481,9 @@ TEST(HistoryChannel, ANetworkTakingItsOutputAtTheJitterTrainsAndExports) {
 // reproduced by ONNX Runtime within 1e-4. A frame range the data set does not have is an error
 // naming the data set and its size.
 TEST(HistoryChannel, ATemporalNetworkExportedMatchesOverASequenceWithASceneCut) {
-  const std::string out = expect_trains_and_exports(
-      "output-at-jitter-sequence",
-      "--set 'enhance.rit.channels=[depth, history, jitter]' --set enhance.rit.history_blend=true"
-      " --set enhance.rit.skip_at_jitter=true --set enhance.rit.residual_at_jitter=true",
-      "[1, 7, 96, 128]", two_scene_data().string() + " --frames 2:10");
+  const std::string out =
+      expect_trains_and_exports("output-at-jitter-sequence", output_at_jitter("[depth, history, jitter]"),
+                                "[1, 7, 96, 128]", two_scene_data().string() + " --frames 2:10");
   ASSERT_EQ(Dataset::open(two_scene_data()).scenes().at(1).first_frame, 6);
   for (int f = 2; f < 10; ++f)
     EXPECT_TRUE(onnxruntime_passed(out, "frame " + std::to_string(f) + " (64x48)")) << "frame " << f << "\n" << out;
