@@ -176,8 +176,21 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   Progress progress("eval " + result.name, static_cast<int64_t>(frames.size()));
   double psnr_sum = 0, ssim_sum = 0;
   int psnr_count = 0;
+  // A recurrent upscaler runs the frames of the scene up to `frame` first, from its first frame or
+  // the last one run; the frame before's output is kept for the temporal error.
+  int last_run = -1;
+  torch::Tensor run_before;
   // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
   const auto upscale_frame = [&](const Batch& b, int frame) {
+    if (upscaler.recurrent()) {
+      const SceneInfo& scene = data.scene_of(frame);
+      const bool continues = last_run >= scene.first_frame && last_run < frame;
+      if (!continues) upscaler.reset_history();
+      run_before = torch::Tensor();
+      for (int f = continues ? last_run + 1 : scene.first_frame; f < frame; ++f)
+        run_before = upscaler.upscale(frame_batch(data, f, result.scale, channels, depth)).clamp(0.0, 1.0);
+      last_run = frame;
+    }
     if (upscaler.uses_previous_frame()) {
       if (data.has_previous(frame))
         upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));
@@ -225,7 +238,9 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
     if (temporal && data.has_previous(frame)) {  // a scene's first frame has no predecessor
       const bool consecutive = last_frame == frame - 1;
       const Batch prev = consecutive ? last_batch : frame_batch(data, frame - 1, result.scale, channels, depth);
-      const auto prev_sr = consecutive ? last_sr : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
+      const auto prev_sr = consecutive                  ? last_sr
+                           : upscaler.recurrent()       ? run_before
+                                                        : upscale_frame(prev, frame - 1).clamp(0.0, 1.0);
       const auto motion = hr_motion(b, data, frame, lr_resolution, result.scale);
       score.temporal_error = warping_error(sr, prev_sr, motion);
       score.temporal_error_reference = warping_error(b.hr_color, prev.hr_color, motion);

@@ -8,6 +8,7 @@
 #include "eval/baselines/history_fill.h"
 #include "eval/baselines/interpolation.h"
 #include "models/inference.h"
+#include "render_data/history_channel.h"
 
 namespace cgsr {
 namespace {
@@ -121,14 +122,37 @@ NetworkUpscaler::NetworkUpscaler(std::string name, SRNetwork network, InferenceE
              "network upscaler: only the fused engine runs in reduced precision");
 }
 
+bool NetworkUpscaler::recurrent() const { return reads_previous_output(network_->input_channels()); }
+
+void NetworkUpscaler::reset_history() {
+  previous_ = torch::Tensor();
+  previous_frame_ = -1;
+}
+
 torch::Tensor NetworkUpscaler::upscale(const Batch& batch) {
-  const auto info = network_->info_input(batch);
-  if (engine_ == InferenceEngine::LibTorch) return infer(*network_, batch.lr_color, info);
-  if (!fused_) {
-    network_->eval();
-    fused_ = std::make_shared<FusedGraph>(network_->describe(), fused_options_);
+  auto info = network_->info_input(batch);
+  const int frame = batch.frames.size() == 1 ? batch.frames.front() : -1;
+  const bool recurs = recurrent();
+  if (recurs) {
+    const bool follows = previous_.defined() && frame >= 0 && frame == previous_frame_ + 1 &&
+                         previous_.size(0) == batch.lr_color.size(0);
+    info = with_previous_output(info, network_->input_channels(), follows ? previous_ : torch::Tensor());
   }
-  return fused_->run(batch.lr_color, info);
+  torch::Tensor out;
+  if (engine_ == InferenceEngine::LibTorch) {
+    out = infer(*network_, batch.lr_color, info);
+  } else {
+    if (!fused_) {
+      network_->eval();
+      fused_ = std::make_shared<FusedGraph>(network_->describe(), fused_options_);
+    }
+    out = fused_->run(batch.lr_color, info);
+  }
+  if (recurs) {
+    previous_ = out;
+    previous_frame_ = frame;
+  }
+  return out;
 }
 
 std::optional<Complexity> NetworkUpscaler::cost(int64_t lr_width, int64_t lr_height) const {

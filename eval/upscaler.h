@@ -51,6 +51,10 @@ class Upscaler {
   // The next frame has no predecessor (a sequence's first frame, or a scene cut in a multi-scene
   // data set): forget every frame seen so far.
   virtual void reset_history() {}
+  // Recurrent upscalers read their own output for the frame before (history_out): callers run
+  // every frame of a scene in order, from its first (or the last one run), calling reset_history()
+  // at its first. A frame that does not follow the last one run starts without that output.
+  virtual bool recurrent() const { return false; }
   // The pattern the last upscale() chose, for the per-frame record; none for upscalers that
   // choose nothing.
   virtual std::optional<PatternChoice> frame_choice() const { return std::nullopt; }
@@ -83,6 +87,8 @@ class NetworkUpscaler : public Upscaler {
   std::optional<Complexity> cost(int64_t lr_width, int64_t lr_height) const override;
   SRNetwork network() const { return network_; }
   Precision precision() const override { return fused_options_.precision; }
+  bool recurrent() const override;
+  void reset_history() override;
 
  private:
   std::string name_;
@@ -90,6 +96,9 @@ class NetworkUpscaler : public Upscaler {
   InferenceEngine engine_;
   FusedGraph::Options fused_options_;
   std::shared_ptr<FusedGraph> fused_;  // built at the first upscale()
+  // A recurrent network's last output and its frame (-1: none).
+  torch::Tensor previous_;
+  int previous_frame_ = -1;
 };
 
 }  // namespace cgsr

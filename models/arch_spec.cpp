@@ -178,7 +178,16 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
                                 "does not give: use " + join(hr_sources, ", or ")});
   };
   check_output_option(spec.rit.bsp_composite, "bsp_composite", RenderChannel::Bsp, "composites the output with");
-  check_output_option(spec.rit.history_blend, "history_blend", RenderChannel::History, "blends the output with");
+  const bool recurrent =
+      std::find(rit_channels.begin(), rit_channels.end(), RenderChannel::HistoryOut) != rit_channels.end();
+  check_output_option(spec.rit.history_blend, "history_blend", recurrent ? RenderChannel::HistoryOut : RenderChannel::History,
+                      "blends the output with");
+  if (recurrent && spec.rit.enabled && !spec.rit.reads_hr())
+    problems.push_back({"rit.source", "history_out warps the previous output at the output resolution, which rit.source "
+                                      "lr does not give: use an HR source"});
+  if (recurrent && spec.geometry.enabled)
+    problems.push_back({"geometry.enabled", "the geometry head would predict history_out, the network's own output: "
+                                            "disable it"});
   check_output_option(spec.rit.skip_at_jitter, "skip_at_jitter", RenderChannel::Jitter, "takes the image skip at");
   if (spec.rit.skip_at_jitter && (!info.has_image_skip || spec.image_skip != ImageSkip::Bilinear))
     problems.push_back({"rit.skip_at_jitter", info.has_image_skip

@@ -25,7 +25,9 @@
 //     bsp_composite: false   # the output is the bsp channel's image where its coverage is 1,
 //                            #   the network's elsewhere (needs bsp among channels, an HR source)
 //     history_blend: false   # the output blended with the history channel's samples by a learned
-//                            #   weight (needs history among channels, an HR source)
+//                            #   weight (needs history among channels, an HR source); with
+//                            #   history_out among them (the network's own previous output,
+//                            #   warped: a recurrent network, HR sources only), with that
 //     skip_at_jitter: false  # PAN's bilinear image skip taken at the jitter channel's offsets
 //                            #   (needs jitter among channels, an HR source)
 //     residual_at_jitter: false  # the rest of the output moved to the jitter as well, at HR

@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
+
 #include "core/error.h"
 #include "models/layers.h"
 
@@ -73,9 +75,25 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     complement_scale_ = torch::full({3}, -1.0f);
     complement_shift_ = torch::full({3}, 1.0f);
   }
+  const auto& channels = rit.render_channels();
+  const bool recurrent = std::find(channels.begin(), channels.end(), RenderChannel::HistoryOut) != channels.end();
+  if (recurrent) {
+    CGSR_CHECK(info_factor_ == scale, "RIT: history_out needs the information at the output resolution");
+    const int64_t offset = channel_offset(channels, RenderChannel::HistoryOut);
+    previous_color_ = selection(c, offset, 1);
+    previous_validity_ = selection(c, offset + 3, 0);
+    previous_motion_ = torch::zeros({2, c, 1, 1});
+    previous_motion_[0][offset + 4] = 1.0f;
+    previous_motion_[1][offset + 5] = 1.0f;
+    previous_keep_ = torch::eye(c).view({c, c, 1, 1});
+    for (int64_t k : {0, 1, 2, 4, 5}) previous_keep_[offset + k][offset + k] = 0.0f;
+    previous_embed_ = torch::zeros({c, 3, 1, 1});
+    for (int64_t k = 0; k < 3; ++k) previous_embed_[offset + k][k] = 1.0f;
+  }
   if (rit.history_blend) {
     CGSR_CHECK(info_factor_ == scale, "RIT: history_blend needs the information at the output resolution");
-    const int64_t offset = channel_offset(rit.render_channels(), RenderChannel::History);
+    // The recurrent history when there is one: every frame so far, where the sampled one has five.
+    const int64_t offset = channel_offset(channels, recurrent ? RenderChannel::HistoryOut : RenderChannel::History);
     history_color_ = selection(c, offset, 1);
     history_recency_ = selection(c, offset + 3, 0);
     ParameterBudget::charge_conv(3 + c, 3, 3, 1, /*bias=*/true);
@@ -96,6 +114,28 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     negate_scale_ = torch::full({3}, -1.0f);
     negate_shift_ = torch::zeros({3});
   }
+}
+
+torch::Tensor RitBlockImpl::warp_previous_output(const torch::Tensor& info) const {
+  if (!reads_previous_output()) return info;
+  // The kernels and the operand order of describe_warp_previous_output(), so both give the same bits.
+  const auto warped = graph::apply_sample(torch::conv2d(info, previous_color_), torch::conv2d(info, previous_motion_), 1,
+                                          graph::ResizeMode::Bilinear);
+  return torch::conv2d(info, previous_keep_) + torch::conv2d(warped * torch::conv2d(info, previous_validity_), previous_embed_);
+}
+
+int RitBlockImpl::describe_warp_previous_output(graph::Builder& g, int info) const {
+  if (!reads_previous_output()) return info;
+  const auto rgb = graph::fixed_layout("rgb", 3);
+  const auto layout = g.value(info).layout;
+  const int color = g.conv("previous_color", info, previous_color_, {}, 0, rgb, /*trainable=*/false);
+  const int motion = g.conv("previous_motion", info, previous_motion_, {}, 0, graph::fixed_layout("motion", 2),
+                            /*trainable=*/false);
+  const int warped = g.sample(color, motion, graph::ResizeMode::Bilinear);
+  const int validity = g.conv("previous_validity", info, previous_validity_, {}, 0, rgb, /*trainable=*/false);
+  const int kept = g.conv("previous_keep", info, previous_keep_, {}, 0, layout, /*trainable=*/false);
+  return g.add(kept, g.conv("previous_embed", g.mul(warped, validity), previous_embed_, {}, 0, layout,
+                            /*trainable=*/false));
 }
 
 torch::Tensor RitBlockImpl::gate_info(const torch::Tensor& info) const {

@@ -33,8 +33,15 @@
 // the info input, a ChannelAffine for 1 - m, Mul and Add: every runtime runs it, and as m is 0 or
 // 1 the result is exactly bsp_rgb or net (0 * x + y == y), not net + (bsp - net) rounded.
 //
+// history_out: the network's own previous output, passed back in by the runner, is warped to this
+// frame first (graph Sample at the channel's motion, bilinear, border padding) and zeroed where the
+// channel's validity is 0; every part below reads that instead of the raw channel. Written with
+// fixed 0/1 1x1 convs, Sample, Mul and Add: the exported file warps it too, and the state it takes
+// is the previous output as the network returned it (docs/temporal.md).
+//
 // rit.history_blend: the image blended with the history channel's samples (render_data/
-// history_channel.h), read from the raw HR input: out = net + w * (hist_rgb - net), with
+// history_channel.h; history_out's warped output instead when the RIT reads it), read from the
+// HR input: out = net + w * (hist_rgb - net), with
 // w = sigmoid(conv3x3(cat(net, info))) * recency. Recency is 0 where no frame left a sample, so the
 // output there is the network's exactly; elsewhere the conv (layer "blend", 3 outputs, starting at
 // weight 0 and bias -4: w under 0.02) learns how far to trust a sample from its age, the
@@ -78,6 +85,12 @@ class RitBlockImpl : public torch::nn::Module {
  public:
   RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, FusionPoint hr_features);
 
+  // history_out (render_channels.h): the information with that channel's previous output warped to
+  // this frame through its motion (bilinear, graph Sample) and zeroed where it is not valid, and
+  // its motion zeroed (the warp's alone); what every other part reads. `info` itself without it.
+  bool reads_previous_output() const { return previous_keep_.defined(); }
+  torch::Tensor warp_previous_output(const torch::Tensor& info) const;
+  int describe_warp_previous_output(graph::Builder& g, int info) const;
   // The gated information both parts read (hr_pooled: pooled first, as the gate always was).
   torch::Tensor gate_info(const torch::Tensor& info) const;
   torch::Tensor fuse_features(const torch::Tensor& features, const torch::Tensor& gated);
@@ -132,6 +145,10 @@ class RitBlockImpl : public torch::nn::Module {
   // skip_at_jitter: a constant [2, C, 1, 1] selection of the jitter (x, y); residual_at_jitter:
   // the same times the scale (the jitter in HR pixels), else undefined.
   torch::Tensor jitter_offsets_, hr_jitter_offsets_;
+  // history_out: constants, [3, C, 1, 1] selections of the previous colour and of its validity
+  // (broadcast), [2, C, 1, 1] of its motion; [C, C, 1, 1] the identity but for the colour and the
+  // motion, and [C, 3, 1, 1] the warped colour back into the colour's place.
+  torch::Tensor previous_color_, previous_validity_, previous_motion_, previous_keep_, previous_embed_;
   int64_t scale_;
 };
 TORCH_MODULE(RitBlock);

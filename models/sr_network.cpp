@@ -49,16 +49,17 @@ Reconstruction SRNetworkImpl::run(const torch::Tensor& lr_color, const torch::Te
   check_inputs(lr_color, info);
   const auto extracted = backbone_->extract(lr_color);
   if (!has_rit()) return backbone_->reconstruct(extracted.features, extracted.skip, {});
-  const auto gated = rit_->gate_info(info);
+  const auto in = rit_->warp_previous_output(info);
+  const auto gated = rit_->gate_info(in);
   const auto features = rit_->has_feature_branch() ? rit_->fuse_features(extracted.features, gated) : extracted.features;
   HrFusion at_hr;
   if (rit_->has_hr_branch()) at_hr = [&](const torch::Tensor& hr) { return rit_->fuse_hr(hr, gated); };
   auto recon = backbone_->reconstruct(features, extracted.skip, at_hr);
   // Last, on the image every caller sees (training's loss too), from the ungated input: the skip
   // at the jitter, then the history, then the renderer's exact BSP borders.
-  if (rit_->skips_at_jitter()) recon.image = rit_->skip_at_jitter(recon.image, lr_color, info);
-  if (rit_->blends_history()) recon.image = rit_->blend_history(recon.image, info);
-  if (rit_->composites_bsp()) recon.image = rit_->composite_bsp(recon.image, info);
+  if (rit_->skips_at_jitter()) recon.image = rit_->skip_at_jitter(recon.image, lr_color, in);
+  if (rit_->blends_history()) recon.image = rit_->blend_history(recon.image, in);
+  if (rit_->composites_bsp()) recon.image = rit_->composite_bsp(recon.image, in);
   return recon;
 }
 
@@ -109,7 +110,11 @@ graph::Graph SRNetworkImpl::describe_graph(bool training) const {
   graph::Builder g;
   g.set_training(training);
   const int color = g.input("color", graph::fixed_layout("rgb", 3), 1);
-  const int info = has_rit() ? g.input(rit_->input_name(), info_layout(input_channels()), rit_->info_factor()) : -1;
+  int info = has_rit() ? g.input(rit_->input_name(), info_layout(input_channels()), rit_->info_factor()) : -1;
+  if (has_rit() && rit_->reads_previous_output()) {
+    auto scope = g.scope("rit");
+    info = rit_->describe_warp_previous_output(g, info);
+  }
   ExtractedPorts extracted;
   {
     auto scope = g.scope("backbone");

@@ -19,6 +19,7 @@
 #include "models/model_source.h"
 #include "pruning/hybrid_model.h"
 #include "render_data/dataset.h"
+#include "render_data/history_channel.h"
 #include "render_data/patch_sampler.h"
 
 namespace cgsr {
@@ -223,8 +224,14 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
   }
   VerifyCase c = make_verify_case(*net, exported, sizes, seed, forward);
   if (data) {
+    // A recurrent network's state: its output for the frame before, as cgsr computed it; none at a
+    // scene's first frame (a cut), as an engine resets it.
+    torch::Tensor previous;
+    int previous_frame = -1;
     for (int frame : verification_frames(*data, options.frames)) {
-      const Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
+      Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
+      const bool follows = previous.defined() && previous_frame == frame - 1 && data->has_previous(frame);
+      b.hr_info = with_previous_output(b.hr_info, b.channels, follows ? previous : torch::Tensor());  // read at HR
       const int64_t fw = b.lr_color.size(3), fh = b.lr_color.size(2);
       if (!exported.dynamic_size && (fw != w || fh != h)) {
         // The first test frame is a bonus check; frames asked for must run.
@@ -234,6 +241,8 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
                                       " (--input, or --dynamic-size)");
       }
       add_verify_inputs(c, *net, inputs_from_batch(*net, b), forward, "frame " + std::to_string(frame));
+      previous = c.expected.back();
+      previous_frame = frame;
     }
   }
   const VerifyReport report = verify_exports({c}, v);

@@ -58,10 +58,12 @@ torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderCh
   int64_t offset = 0;
   for (auto c : channels) {
     const int width = channel_width(c);
-    if (c == RenderChannel::Normal || c == RenderChannel::Motion || c == RenderChannel::Jitter) {
+    if (c == RenderChannel::Normal || c == RenderChannel::Motion || c == RenderChannel::Jitter ||
+        c == RenderChannel::HistoryOut) {
       // Components in image orientation: motion and jitter are (x right, y down); normals (x right, y up).
       const bool y_up = c == RenderChannel::Normal;
-      auto x = t.select(cdim, offset).clone(), y = t.select(cdim, offset + 1).clone();
+      const int64_t at = offset + (c == RenderChannel::HistoryOut ? 4 : 0);  // history_out: its motion
+      auto x = t.select(cdim, at).clone(), y = t.select(cdim, at + 1).clone();
       if (a.flip) x = -x;
       for (int r = 0; r < a.rotations % 4; ++r) {
         // Counter-clockwise: y-down (dx, dy) -> (dy, -dx); y-up (x, y) -> (-y, x).
@@ -69,8 +71,8 @@ torch::Tensor augment_info(const torch::Tensor& info, const std::vector<RenderCh
         x = nx;
         y = ny;
       }
-      t.select(cdim, offset).copy_(x);
-      t.select(cdim, offset + 1).copy_(y);
+      t.select(cdim, at).copy_(x);
+      t.select(cdim, at + 1).copy_(y);
     }
     offset += width;
   }

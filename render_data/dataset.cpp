@@ -142,7 +142,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
       info.derived.push_back(c);
       continue;
     }
-    if (c == RenderChannel::History) {
+    if (c == RenderChannel::History || c == RenderChannel::HistoryOut) {
       // Made from motion and depth (history_channel.h): an error when no resolution can have it.
       std::vector<std::string> why;
       bool anywhere = false;
@@ -152,7 +152,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
         if (!missing.empty()) why.push_back(info.resolutions[r].name() + ": " + missing);
       }
       if (!anywhere)
-        throw Error(info.root.string(), "cannot derive the 'history' channel at any resolution (" + join(why, "; ") +
+        throw Error(info.root.string(), "cannot derive the '" + channel_name(c) + "' channel at any resolution (" + join(why, "; ") +
                                             "): it is made from the motion and depth of the previous frames");
       info.derived.push_back(c);
       continue;
@@ -180,7 +180,7 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
     for (auto c : requested) {
       const bool derived = std::find(info.derived.begin(), info.derived.end(), c) != info.derived.end();
       const bool available = c == RenderChannel::Bsp       ? bsp_available_at(info, r)
-                             : c == RenderChannel::History ? history_available_at(info, r)
+                             : c == RenderChannel::History || c == RenderChannel::HistoryOut ? history_available_at(info, r)
                              : c == RenderChannel::Jitter  ? true
                                                            : has(c) || (derived && has(RenderChannel::Depth));
       if (available) out.push_back(c);
@@ -192,7 +192,9 @@ void resolve_channels(DatasetInfo& info, const DatasetOpenOptions& options) {
 std::vector<RenderChannel> depth_derived(const DatasetInfo& info) {
   std::vector<RenderChannel> out;
   for (auto c : info.derived)
-    if (c != RenderChannel::Bsp && c != RenderChannel::History && c != RenderChannel::Jitter) out.push_back(c);
+    if (c != RenderChannel::Bsp && c != RenderChannel::History && c != RenderChannel::Jitter &&
+        c != RenderChannel::HistoryOut)
+      out.push_back(c);
   return out;
 }
 
@@ -332,6 +334,9 @@ struct Dataset::Impl {
     if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::History) != info.channels.end() &&
         history_available_at(info, res))
       f.history = resolve_history(index, res, f);
+    if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::HistoryOut) != info.channels.end() &&
+        history_available_at(info, res))
+      f.history_out = resolve_history_out(index, res, f);
     if (std::find(info.channels.begin(), info.channels.end(), RenderChannel::Jitter) != info.channels.end()) {
       const auto jitter = res == 0 ? f.jitter : source->load(index, 0, {}).jitter;
       f.lr_jitter = torch::tensor({static_cast<float>(jitter[0]), static_cast<float>(jitter[1])}).view({2, 1, 1});
@@ -382,6 +387,17 @@ struct Dataset::Impl {
     }
     return history_channel(chain, scale, info.root.string() + ": frame " + std::to_string(index) + " at " +
                                              info.resolutions[res].name());
+  }
+
+  // The history_out channel's data part of frame `index` at resolution `res`: its reprojection into
+  // the previous frame of its scene (none at the scene's first frame), read like resolve_history's.
+  torch::Tensor resolve_history_out(int index, size_t res, const Frame& f) const {
+    Frame lr;
+    const Frame here = f.depth.defined() && f.motion.defined() ? f : depth_and_motion(index, res, lr);
+    torch::Tensor previous_depth;
+    if (has_previous_frame(info, index)) previous_depth = depth_and_motion(index - 1, res, lr).depth;
+    return history_out_channel(here.depth, here.motion, previous_depth,
+                               info.root.string() + ": frame " + std::to_string(index) + " at " + info.resolutions[res].name());
   }
 
   // The bsp channel of frame `index` at resolution `res`: the LR frame's BSP border image resolved
@@ -493,7 +509,7 @@ Dataset open_for_channels(const fs::path& path, const std::vector<RenderChannel>
   for (auto c : channels) need(c);
   // Derived only when asked for (history, jitter), or kept when the data cannot give it, so that
   // opening says what is missing and how to render it.
-  for (auto c : {RenderChannel::Bsp, RenderChannel::History, RenderChannel::Jitter})
+  for (auto c : {RenderChannel::Bsp, RenderChannel::History, RenderChannel::Jitter, RenderChannel::HistoryOut})
     if (std::find(channels.begin(), channels.end(), c) != channels.end() &&
         std::find(needed.begin(), needed.end(), c) == needed.end())
       needed.push_back(c);
@@ -510,7 +526,7 @@ Dataset open_with_asked_channels(const fs::path& path, const std::vector<RenderC
   auto wanted = all.info().channels;
   const auto has = [](const std::vector<RenderChannel>& v, RenderChannel c) { return std::find(v.begin(), v.end(), c) != v.end(); };
   bool added = false;
-  for (auto c : {RenderChannel::History, RenderChannel::Jitter})
+  for (auto c : {RenderChannel::History, RenderChannel::Jitter, RenderChannel::HistoryOut})
     if (has(channels, c) && !has(wanted, c)) {
       wanted.push_back(c);
       added = true;

@@ -17,6 +17,7 @@ bool Frame::has(RenderChannel c) const {
     case RenderChannel::Bsp: return bsp.defined();
     case RenderChannel::History: return history.defined();
     case RenderChannel::Jitter: return lr_jitter.defined();
+    case RenderChannel::HistoryOut: return history_out.defined();
   }
   return false;
 }
@@ -44,6 +45,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
       case RenderChannel::Bsp: parts.push_back(bsp); break;
       case RenderChannel::History: parts.push_back(history); break;
       case RenderChannel::Jitter: parts.push_back(lr_jitter.expand({2, height, width}).contiguous()); break;
+      case RenderChannel::HistoryOut: parts.push_back(history_out); break;
     }
   }
   if (parts.empty()) return torch::zeros({0, height, width}, torch::kFloat32);
@@ -52,7 +54,7 @@ torch::Tensor Frame::info(const std::vector<RenderChannel>& channels, DepthEncod
 
 size_t Frame::bytes() const {
   size_t n = 0;
-  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp, &history, &lr_jitter})
+  for (const auto* t : {&color, &depth, &normal, &normal_angle, &edge, &motion, &bsp, &history, &lr_jitter, &history_out})
     if (t->defined()) n += t->numel() * t->element_size();
   if (bsp_border) n += bsp_border->bytes();
   return n;
@@ -69,7 +71,8 @@ Frame crop(const Frame& f, int x, int y, int w, int h) {
   for (auto [dst, from] : {std::pair{&out.color, &src->color}, std::pair{&out.depth, &src->depth},
                            std::pair{&out.normal, &src->normal}, std::pair{&out.normal_angle, &src->normal_angle},
                            std::pair{&out.edge, &src->edge}, std::pair{&out.motion, &src->motion},
-                           std::pair{&out.bsp, &src->bsp}, std::pair{&out.history, &src->history}})
+                           std::pair{&out.bsp, &src->bsp}, std::pair{&out.history, &src->history},
+                           std::pair{&out.history_out, &src->history_out}})
     if (from->defined()) *dst = from->slice(1, y, y + h).slice(2, x, x + w);
   return out;
 }

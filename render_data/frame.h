@@ -37,6 +37,9 @@ struct Frame {
   // float32 [2,1,1]: the jitter channel (render_channels.h), the LR frame's jitter in LR pixels at
   // every resolution, derived on load; info() spreads it over the frame, crop() keeps it.
   torch::Tensor lr_jitter;
+  // float32 [6,H,W]: the history_out channel's data part (render_channels.h): colour 0, the
+  // reprojection's validity into the previous frame, the motion (history_channel.h).
+  torch::Tensor history_out;
   DepthPrecision depth_precision;  // of `depth` as it was stored (exact unless read from integers)
   // The sub-pixel BSP border image, when the data set stores one at this resolution (cgsr data
   // sets rendered with bsp_border; bsp_border.h); null otherwise. crop() drops it: its lines are

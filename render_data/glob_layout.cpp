@@ -275,7 +275,8 @@ class GlobDataset : public FrameSource {
           break;
         case RenderChannel::Bsp:  // never stored: resolve_channels only derives them
         case RenderChannel::History:
-        case RenderChannel::Jitter: break;
+        case RenderChannel::Jitter:
+        case RenderChannel::HistoryOut: break;
       }
     }
     return f;

@@ -33,7 +33,7 @@ struct Planes {
 
 torch::Tensor checked(const torch::Tensor& t, int64_t channels, int64_t h, int64_t w, const std::string& what,
                       const std::string& name) {
-  if (!t.defined()) throw Error(what, "the history channel needs " + name + ", which the frame does not have");
+  if (!t.defined()) throw Error(what, "needs " + name + ", which the frame does not have");
   if (t.dim() != 3 || t.size(0) != channels || t.size(1) != h || t.size(2) != w)
     throw Error(what, name + " must be [" + std::to_string(channels) + ", " + std::to_string(h) + ", " +
                           std::to_string(w) + "], got " + shape_string(t));
@@ -41,6 +41,76 @@ torch::Tensor checked(const torch::Tensor& t, int64_t channels, int64_t h, int64
 }
 
 }  // namespace
+
+torch::Tensor history_out_channel(const torch::Tensor& depth, const torch::Tensor& motion,
+                                  const torch::Tensor& previous_depth, const std::string& what,
+                                  const HistoryDepthTest& depth_test) {
+  if (!depth.defined()) throw Error(what, "the history_out channel needs depth, which the frame does not have");
+  const int64_t h = depth.size(-2), w = depth.size(-1);
+  const auto d = checked(depth, 1, h, w, what, "depth");
+  const auto m = checked(motion, 2, h, w, what, "motion");
+  auto out = torch::zeros({6, h, w}, torch::kFloat32);
+  out.narrow(0, 4, 2).copy_(m);
+  if (!previous_depth.defined()) return out;
+  const auto p = checked(previous_depth, 1, h, w, what, "the previous frame's depth");
+  const float *dd = d.data_ptr<float>(), *mm = m.data_ptr<float>(), *pd = p.data_ptr<float>();
+  float* valid = out[3].data_ptr<float>();
+  const int64_t n = h * w;
+  tbb::parallel_for(int64_t(0), h, [&](int64_t y) {
+    for (int64_t x = 0; x < w; ++x) {
+      const int64_t i = y * w + x;
+      if (std::isinf(dd[i])) continue;
+      const double qx = x + 0.5 + mm[i], qy = y + 0.5 + mm[n + i];
+      if (!(qx >= 0 && qx < w && qy >= 0 && qy < h)) continue;
+      const float older = pd[static_cast<int64_t>(qy) * w + static_cast<int64_t>(qx)];
+      valid[i] = history_link_holds(older, dd[i], depth_test) ? 1.0f : 0.0f;
+    }
+  });
+  return out;
+}
+
+namespace {
+// Where history_out starts in an info tensor of `channels`; -1 without it.
+int64_t history_out_offset(const std::vector<RenderChannel>& channels) {
+  int64_t offset = 0;
+  for (auto c : channels) {
+    if (c == RenderChannel::HistoryOut) return offset;
+    offset += channel_width(c);
+  }
+  return -1;
+}
+}  // namespace
+
+bool reads_previous_output(const std::vector<RenderChannel>& channels) { return history_out_offset(channels) >= 0; }
+
+torch::Tensor with_previous_output(const torch::Tensor& info, const std::vector<RenderChannel>& channels,
+                                   const torch::Tensor& previous) {
+  const int64_t offset = history_out_offset(channels);
+  if (offset < 0) return info;
+  if (!previous.defined()) {
+    auto out = info.clone();
+    out.select(1, offset + 3).zero_();
+    return out;
+  }
+  if (previous.dim() != 4 || previous.size(1) != 3 || previous.size(0) != info.size(0) ||
+      previous.size(2) != info.size(2) || previous.size(3) != info.size(3))
+    throw Error("history_out", "the previous output must be [" + std::to_string(info.size(0)) + ", 3, " +
+                                   std::to_string(info.size(2)) + ", " + std::to_string(info.size(3)) + "], got " +
+                                   shape_string(previous));
+  return torch::cat({info.narrow(1, 0, offset), previous.clamp(0, 1).to(info.scalar_type()),
+                     info.narrow(1, offset + 3, info.size(1) - offset - 3)},
+                    1);
+}
+
+void restrict_history_out_to_window(torch::Tensor& info, const std::vector<RenderChannel>& channels) {
+  const int64_t offset = history_out_offset(channels);
+  if (offset < 0) return;
+  const int64_t h = info.size(-2), w = info.size(-1);
+  const auto x = torch::arange(w, torch::kFloat32).add_(0.5).view({1, w}) + info[offset + 4];
+  const auto y = torch::arange(h, torch::kFloat32).add_(0.5).view({h, 1}) + info[offset + 5];
+  const auto inside = (x >= 0).logical_and_(x < w).logical_and_(y >= 0).logical_and_(y < h);
+  info[offset + 3].mul_(inside.to(torch::kFloat32));
+}
 
 torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale, const std::string& what,
                               const HistoryDepthTest& depth_test) {

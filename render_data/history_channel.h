@@ -19,6 +19,8 @@
 
 #include <torch/types.h>
 
+#include "render_data/render_channels.h"
+
 #include <array>
 #include <string>
 #include <vector>
@@ -60,5 +62,39 @@ bool history_link_holds(float older, float newer, const HistoryDepthTest& test);
 // the wrong size.
 torch::Tensor history_channel(const std::vector<HistoryFrame>& frames, int scale, const std::string& what,
                               const HistoryDepthTest& depth_test = {});
+
+// The history_out channel's depth test: a looser link than the history's. A point's view depth
+// changes from frame to frame as the camera moves (10% in a frame of the tiny scene's walk), and
+// one link per frame has no chain to share the error with: on that walk the 10% bound kept 28% of
+// the pixels and rejected the rest at 30.7 dB against the kept ones' 32.7; 50% keeps 90% and
+// rejects 1% at 27.2 dB against 31.3 (tests/eval/test_recurrent_network.cpp).
+constexpr double kHistoryOutDepthTolerance = 0.5;
+
+// The history_out channel's data part (render_channels.h) at one resolution: float32 [6, H, W],
+// colour 0 (the runner passes its previous output there), validity, motion. Pixel p is valid where
+// p + 0.5 + motion(p) lies inside the frame and `previous_depth` there (nearest) passes the link
+// test against depth(p); the sky (no previous pixel: motion 0) and every pixel of a frame without a
+// previous one (`previous_depth` undefined) are not. `depth` and `previous_depth` are [1, H, W]
+// linear view depth, `motion` [2, H, W] at the same resolution. Errors name `what`.
+torch::Tensor history_out_channel(const torch::Tensor& depth, const torch::Tensor& motion,
+                                  const torch::Tensor& previous_depth, const std::string& what,
+                                  const HistoryDepthTest& depth_test = {kHistoryOutDepthTolerance,
+                                                                        kHistoryOutDepthTolerance,
+                                                                        kHistoryOutDepthTolerance});
+
+// A batch's rendering information `info` [N, C, H, W] (stacked as `channels` says) with the
+// previous output [N, 3, H, W] in history_out's colour, clamped to [0, 1] as a displayed frame is:
+// what a runner of a recurrent network passes each frame. Undefined `previous` (a sequence's first frame, or after a scene cut): validity 0
+// instead, so the network runs on this frame alone. `info` itself when `channels` has no
+// history_out. Out of place: training's gradients flow through `previous`.
+torch::Tensor with_previous_output(const torch::Tensor& info, const std::vector<RenderChannel>& channels,
+                                   const torch::Tensor& previous);
+// Whether `channels` hold history_out: the network reads its own previous output.
+bool reads_previous_output(const std::vector<RenderChannel>& channels);
+
+// `info` [C, H, W] (channels stacked as `channels` says) with history_out's validity set to 0
+// where p + 0.5 + motion leaves the H x W window: a training patch's previous output ends there.
+// In place; nothing when `channels` has no history_out.
+void restrict_history_out_to_window(torch::Tensor& info, const std::vector<RenderChannel>& channels);
 
 }  // namespace cgsr

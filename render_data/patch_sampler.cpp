@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/runtime.h"
 #include "render_data/augment.h"
+#include "render_data/history_channel.h"
 
 namespace cgsr {
 
@@ -45,7 +46,9 @@ void require_channels(const Dataset& data, const std::vector<RenderChannel>& cha
         throw Error(data.info().root.string(), "batches need channel '" + channel_name(c) + "' at " +
                                                    data.resolutions()[r].name() + ", which the dataset does not provide there" +
                                                    (here.empty() ? std::string() : " (it has: " + join(channel_names(here)) + ")") +
-                                                   (c == RenderChannel::History ? ": " + history_missing_at(data.info(), r) : ""));
+                                                   (c == RenderChannel::History || c == RenderChannel::HistoryOut
+                                                        ? ": " + history_missing_at(data.info(), r)
+                                                        : ""));
   }
 }
 
@@ -74,6 +77,12 @@ Item make_item(const Frame& lr, const Frame& hr, int x, int y, int w, int h, int
     it.hr_color = augment_color(it.hr_color, *color);
     it.lr_info = augment_info_color(it.lr_info, channels, *color);
     it.hr_info = augment_info_color(it.hr_info, channels, *color);
+  }
+  // A window's previous output ends at its border, so history_out is valid only where the motion
+  // stays inside the window (in a whole frame that is the data set's validity already).
+  if (std::find(channels.begin(), channels.end(), RenderChannel::HistoryOut) != channels.end()) {
+    restrict_history_out_to_window(it.lr_info, channels);
+    restrict_history_out_to_window(it.hr_info, channels);
   }
   return it;
 }
@@ -131,8 +140,16 @@ PatchSampler::PatchSampler(Dataset data, PatchSamplerOptions options)
   if (o.patch_size > lr.width || o.patch_size > lr.height)
     throw Error("sampler", "LR patch " + std::to_string(o.patch_size) + " is larger than the LR frames " + lr.name());
   require_channels(data_, o.channels, lr_, hr_);
+  if (o.sequence_length < 1)
+    throw Error("sampler", "sequence_length " + config::out_of_range(o.sequence_length, 1, config::kUnbounded));
   frames_ = data_.frames(o.split);
   if (frames_.empty()) throw Error(data_.info().root.string(), "the " + split_name(o.split) + " split has no frames");
+  for (const auto& s : data_.scenes())
+    if (s.frames < o.sequence_length &&
+        std::any_of(frames_.begin(), frames_.end(), [&](int f) { return s.contains(f); }))
+      throw Error(data_.info().root.string(), "scene '" + s.name + "' has " + std::to_string(s.frames) +
+                                                  " frames, fewer than a training sequence's " +
+                                                  std::to_string(o.sequence_length));
   // Weighted scenes: the split's frames per scene, and each scene's share of the draws. Without
   // weights a frame is drawn uniformly from the split, which is each scene in proportion to its
   // frames there (and the draw sequence of a single-scene data set).
@@ -189,23 +206,32 @@ Batch PatchSampler::make(int64_t k, bool parallel) const {
       c.color = ColorAugmentation::from_uniform(u_permutation, uniform01(colour_rng));
     }
   }
-  std::vector<Item> items(o.batch_size);
-  const auto make_one = [&](int i) {
-    const Choice& c = choices[i];
-    const auto l = data_.frame(c.frame, lr_), h = data_.frame(c.frame, hr_);
+  // Sequences: the T consecutive frames of the drawn frame's scene that hold it, as near to ending
+  // at it as the scene allows.
+  const int steps = o.sequence_length;
+  std::vector<int> frames(static_cast<size_t>(steps) * o.batch_size);
+  for (int i = 0; i < o.batch_size; ++i) {
+    const SceneInfo& scene = data_.scene_of(choices[i].frame);
+    const int first = std::clamp(choices[i].frame - (steps - 1), scene.first_frame, scene.first_frame + scene.frames - steps);
+    for (int t = 0; t < steps; ++t) frames[static_cast<size_t>(t) * o.batch_size + i] = first + t;
+  }
+  std::vector<Item> items(frames.size());
+  const auto make_one = [&](int j) {
+    const Choice& c = choices[j % o.batch_size];
+    const int frame = frames[j];
+    const auto l = data_.frame(frame, lr_), h = data_.frame(frame, hr_);
     const Augmentation aug = Augmentation::from_index(c.aug);
-    const SceneInfo& scene = data_.scene_of(c.frame);  // depth is encoded with its scene's planes
-    items[i] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
+    const SceneInfo& scene = data_.scene_of(frame);  // depth is encoded with its scene's planes
+    items[j] = make_item(*l, *h, c.x, c.y, o.patch_size, o.patch_size, o.scale, o.channels, o.depth_encoding,
                          scene.near_plane, scene.far_plane, o.augment ? &aug : nullptr,
                          o.color_augment ? &c.color : nullptr);
   };
+  const int n = static_cast<int>(items.size());
   if (parallel) {
-    tbb::parallel_for(0, o.batch_size, make_one);
+    tbb::parallel_for(0, n, make_one);
   } else {
-    for (int i = 0; i < o.batch_size; ++i) make_one(i);
+    for (int j = 0; j < n; ++j) make_one(j);
   }
-  std::vector<int> frames;
-  for (const auto& c : choices) frames.push_back(c.frame);
   return stack(items, o.channels, o.depth_encoding, frames, o.scale);
 }
 

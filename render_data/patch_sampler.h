@@ -46,6 +46,12 @@ struct PatchSamplerOptions {
   // thread alone (no other thread runs while the caller's compute threads may own every core).
   int prefetch = 2;
   int lr_width = 0;  // LR resolution width; 0: the smallest with a scale-x partner
+  // Recurrent training (history_out): T > 1 makes each batch T steps of batch_size sequences, step
+  // t's items at t * batch_size .. (t + 1) * batch_size - 1. A sequence is T consecutive frames of
+  // the drawn frame's scene that hold it (ending at it when the scene allows), in one window with
+  // one augmentation; Batch::frames names each item's frame, which may lie in another split (its
+  // inputs are context; the trainer scores only the split's frames).
+  int sequence_length = 1;
 };
 
 // The (LR, HR) resolution indices of `data` for `scale` (and an optional LR width).

@@ -20,6 +20,7 @@ const std::vector<ChannelInfo>& table() {
       {RenderChannel::NormalAngle, "normal_angle", 1}, {RenderChannel::Edge, "edge", 1},
       {RenderChannel::Motion, "motion", 2}, {RenderChannel::Bsp, "bsp", 4},
       {RenderChannel::History, "history", 4},   {RenderChannel::Jitter, "jitter", 2},
+      {RenderChannel::HistoryOut, "history_out", 6},
   };
   return t;
 }

@@ -50,6 +50,17 @@
 //                                 and at every resolution: what an engine passes a temporal
 //                                 upscaler each frame, as two constant planes. 0 for unjittered
 //                                 data. Derived on load only when asked for by name
+//   history_out     6    [0,1]    the recurrent state (docs/temporal.md): (r, g, b) the upscaler's
+//                   ..   pixels   own output for the previous frame, as the runner passes it (not
+//                                 warped: the network warps it; 0 in a data set, which cannot know
+//                                 it), then validity, 1 where this frame's pixel was seen by the
+//                                 previous frame of the same scene (p + 0.5 + motion inside that
+//                                 frame, and its depth there within 50% of here: history_channel.h's
+//                                 history_out_channel), 0 at disocclusions, outside it and at a
+//                                 scene's first frame; then the motion (dx, dy) as the motion channel
+//                                 at this resolution. A runner without a previous output sets the
+//                                 validity to 0. Derived on load only when asked for by name, at
+//                                 every integer multiple of the LR resolution (as history)
 
 #include <torch/types.h>
 
@@ -60,7 +71,7 @@
 
 namespace cgsr {
 
-enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp, History, Jitter };
+enum class RenderChannel { Depth, Normal, NormalAngle, Edge, Motion, Bsp, History, Jitter, HistoryOut };
 
 const std::vector<RenderChannel>& all_render_channels();  // in the fixed order above
 const std::string& channel_name(RenderChannel channel);

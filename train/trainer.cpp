@@ -15,6 +15,7 @@
 #include "core/runtime.h"
 #include "core/text.h"
 #include "models/arch_spec.h"
+#include "render_data/history_channel.h"
 #include "render_data/patch_sampler.h"
 #include "train/run_identity.h"
 
@@ -51,6 +52,11 @@ config::Schema<TrainSchedule> schedule_schema() {
   // Left out of the written config at its default, so stage hashes of earlier runs hold (the
   // batches are the same either way).
   s.omit_when("prefetch", [](const TrainSchedule& t) { return t.prefetch == 2; });
+  s.field("sequence_length", &TrainSchedule::sequence_length,
+          "frames per training sequence of a recurrent network (history_out): each step runs them in order, "
+          "each fed the previous one's output; 0: 4 for a recurrent network, 1 otherwise")
+      .range(0, 64);
+  s.omit_when("sequence_length", [](const TrainSchedule& t) { return t.sequence_length == 0; });
   // Off, it is left out too, so stage hashes made before it existed hold.
   s.omit_when("color_augment", [](const TrainSchedule& t) { return !t.color_augment; });
   s.validate([](const TrainSchedule& t, const config::Cursor& at, const YAML::Node& node) {
@@ -164,6 +170,19 @@ Batch in_layout(Batch b, MemoryLayout layout) {
   return b;
 }
 
+// The items `index` of a batch (whole frames' per-item fields stay with their items).
+Batch batch_items(const Batch& b, const torch::Tensor& index) {
+  Batch out = b;
+  for (auto* t : {&out.lr_color, &out.lr_info, &out.hr_color, &out.hr_info})
+    if (t->defined()) *t = t->index_select(0, index);
+  out.frames.clear();
+  const auto* i = index.data_ptr<int64_t>();
+  for (int64_t k = 0; k < index.numel(); ++k) out.frames.push_back(b.frames.at(static_cast<size_t>(i[k])));
+  out.lr_bsp_border.clear();
+  out.lr_jitter.clear();
+  return out;
+}
+
 // Hands the network back in NCHW however run() ends (docs/design.md: NCHW in interfaces).
 struct NchwOnExit {
   torch::nn::Module& module;
@@ -180,6 +199,18 @@ Trainer::Trainer(SRNetwork network, const Dataset& data, TrainSchedule schedule,
       shrink_(std::move(shrink)),
       hooks_(std::move(hooks)),
       channels_(network_->input_channels()) {
+  const bool recurrent = reads_previous_output(channels_);
+  sequence_ = schedule_.sequence_length ? schedule_.sequence_length : (recurrent ? 4 : 1);
+  if (!recurrent && sequence_ > 1)
+    throw Error("schedule.sequence_length", std::to_string(sequence_) + " trains on sequences, which only a recurrent "
+                                            "network (history_out among rit.channels) reads; this one does not");
+  if (recurrent && sequence_ < 2)
+    throw Error("schedule.sequence_length", "a recurrent network (history_out) learns its state from sequences of at "
+                                            "least 2 frames; got 1");
+  if (recurrent && (hooks_.forward || hooks_.extra_loss))
+    throw Error("train", "a recurrent network (history_out) trains without distillation, elastic or pruning hooks");
+  train_frame_.assign(static_cast<size_t>(data_.info().frames), false);
+  for (int f : data_.frames(Split::Train)) train_frame_[static_cast<size_t>(f)] = true;
   val_frames_ = spread_frames(data_.frames(Split::Val), schedule_.val_frames);
   if (val_frames_.empty()) val_frames_ = spread_frames(data_.frames(Split::Train), std::max(1, schedule_.val_frames));
   if (data_.frames(Split::Train).empty())
@@ -192,9 +223,46 @@ std::vector<torch::Tensor> Trainer::tracked() const {
   return out;
 }
 
+// Frames a recurrent network runs before a validation frame, from its scene's start at most.
+constexpr int kValidationWarmup = 8;
+
 TrainOutput Trainer::forward(const Batch& batch, int step) {
   if (hooks_.forward) return hooks_.forward(batch, step);
   return network_->forward_train(batch.lr_color, network_->info_input(batch));
+}
+
+std::pair<TrainOutput, Batch> Trainer::unroll(const Batch& batch) {
+  const int64_t n = batch.lr_color.size(0) / sequence_;
+  std::vector<torch::Tensor> images;
+  torch::Tensor previous;  // none before a sequence's first frame
+  for (int t = 0; t < sequence_; ++t) {
+    const Batch step = batch_items(batch, torch::arange(t * n, (t + 1) * n));
+    previous = network_->forward_train(step.lr_color, with_previous_output(network_->info_input(step), channels_, previous))
+                   .image;
+    images.push_back(previous);
+  }
+  std::vector<int64_t> scored;
+  for (size_t j = 0; j < batch.frames.size(); ++j)
+    if (train_frame_[static_cast<size_t>(batch.frames[j])]) scored.push_back(static_cast<int64_t>(j));
+  const auto index = torch::tensor(scored);
+  TrainOutput out;
+  out.image = torch::cat(images).index_select(0, index);
+  return {out, batch_items(batch, index)};
+}
+
+TrainOutput Trainer::forward_frame(int frame, int step) {
+  const auto batch = [&](int f) {
+    return in_layout(frame_batch(data_, f, network_->spec().scale, channels_, network_->depth_encoding()), layout_);
+  };
+  if (sequence_ == 1) return forward(batch(frame), step);
+  torch::Tensor previous;
+  const int first = std::max(data_.scene_of(frame).first_frame, frame - kValidationWarmup);
+  for (int f = first;; ++f) {
+    const Batch b = batch(f);
+    auto out = network_->forward_train(b.lr_color, with_previous_output(network_->info_input(b), channels_, previous));
+    if (f == frame) return out;
+    previous = out.image;
+  }
 }
 
 MemoryLayout Trainer::choose_layout(const Batch& batch) {
@@ -228,7 +296,7 @@ ValidationScore Trainer::validate(int step) {
   for (int frame : val_frames_) {
     const Batch b =
         in_layout(frame_batch(data_, frame, network_->spec().scale, channels_, network_->depth_encoding()), layout_);
-    const auto out = forward(b, step);
+    const auto out = forward_frame(frame, step);
     const auto image = out.image.clamp(0.0, 1.0);
     score.psnr += psnr(image, b.hr_color).item<double>();
     score.ssim += ssim(image, b.hr_color).item<double>();
@@ -400,6 +468,9 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
   sampling.augment = schedule_.augment;
   sampling.color_augment = schedule_.color_augment;
   sampling.prefetch = schedule_.prefetch;
+  sampling.sequence_length = sequence_;
+  if (world_ && sequence_ > 1)
+    throw Error("train", "a recurrent network (history_out) trains in one process: its batches are sequences");
   PatchSampler sampler(data_, sampling);
   // A resumed run keeps the layout its checkpoint was written in (bit-identical steps).
   if (layout_ == MemoryLayout::Auto && (!world_ || world_->coordinator())) layout_ = choose_layout(sampler.build(step));
@@ -430,9 +501,13 @@ TrainOutcome Trainer::run(const std::optional<std::filesystem::path>& checkpoint
 
     // Batches are a function of the step, so a resumed run sees the same data.
     lap_start = Clock::now();
-    const Batch batch = in_layout(world_ ? rank_slice(sampler.batch(step), *world_) : sampler.batch(step), layout_);
+    Batch batch = in_layout(world_ ? rank_slice(sampler.batch(step), *world_) : sampler.batch(step), layout_);
     lap(spent.batch);
-    const auto output = forward(batch, step);
+    TrainOutput output;
+    if (sequence_ > 1)
+      std::tie(output, batch) = unroll(batch);
+    else
+      output = forward(batch, step);
     LossTerms terms = cgsr_loss(*network_, output, batch, loss_, shrink_);
     if (hooks_.extra_loss) terms.total = terms.total + hooks_.extra_loss(batch, output, step);
     optimizer_->zero_grad();

@@ -52,6 +52,10 @@ struct TrainSchedule {
   int max_nonfinite_steps = 20; // consecutive skipped steps before giving up
   MemoryLayout layout = MemoryLayout::Auto;  // activation memory layout: auto (measured once per machine), nchw or nhwc
   int prefetch = 2;             // batches built ahead on other threads (0: between steps)
+  // Frames per training sequence of a recurrent network (history_out among its channels): each
+  // step runs T consecutive frames in order, each fed the previous one's output, and back-propagates
+  // through all of them. 0: 4 for a recurrent network, 1 otherwise.
+  int sequence_length = 0;
 };
 config::Schema<TrainSchedule> schedule_schema();
 
@@ -133,6 +137,13 @@ class Trainer {
   // The schedule's layout; for auto, measured on a training step of `batch` (memory_layout.h).
   MemoryLayout choose_layout(const Batch& batch);
   TrainOutput forward(const Batch& batch, int step);
+  // Recurrent networks: the batch's sequences run in order (patch_sampler.h), each step fed the
+  // previous step's output; the output and the batch of the items the loss scores (the training
+  // split's frames).
+  std::pair<TrainOutput, Batch> unroll(const Batch& batch);
+  // Frame `frame` as validation scores it; a recurrent network runs the kValidationWarmup frames
+  // of its scene before it first.
+  TrainOutput forward_frame(int frame, int step);
   std::vector<torch::Tensor> tracked() const;  // the network's parameters, then the hooks' extras
   void save_checkpoint(const std::filesystem::path& path, int step, const TrainOutcome& outcome);
   std::map<std::string, std::string> identity() const;  // run_identity.h
@@ -146,6 +157,8 @@ class Trainer {
   TrainHooks hooks_;
   std::vector<RenderChannel> channels_;
   std::vector<int> val_frames_;
+  int sequence_ = 1;                // frames per training sequence (schedule.sequence_length resolved)
+  std::vector<bool> train_frame_;   // per data set frame: in the training split
   MemoryLayout layout_ = MemoryLayout::Nchw;  // where run() keeps parameters and batches
   std::unique_ptr<torch::optim::Adam> optimizer_;
   std::vector<torch::Tensor> best_weights_, last_weights_;

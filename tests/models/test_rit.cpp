@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "models/importance/channel_importance.h"
+#include "models/fused_graph.h"
 #include "models/inherit.h"
 #include "models/sr_network.h"
 #include "render_data/augment.h"
@@ -453,4 +454,50 @@ TEST(Rit, AugmentedJitterSamplesTheAugmentedFrame) {
     const auto of_moved = graph::apply_sample(augment_image(lr, a), moved_planes, s, graph::ResizeMode::Bilinear);
     EXPECT_TRUE(torch::allclose(of_moved, augment_image(sampled, a), 1e-5, 1e-5));
   }
+}
+
+// history_out (the network's own previous output, planes 1-3 here, its validity 4, its motion 5-6)
+// over every backbone, scale and HR source: where no pixel is valid the previous colour changes
+// nothing, bit for bit; where some are it does; a blend weight driven high gives the previous
+// output read at p + motion (a pixel moved 1 to the right reads its right neighbour), in the
+// deployed graph too; the graph computes what forward() does, the fused path what the deployed
+// graph does.
+TEST(Rit, HistoryOutWarpsThePreviousOutputWhereValid) {
+  torch::manual_seed(41);
+  for (const auto& c : all_backbone_cases())
+    for (const auto& source : rit_sources_for(c.backbone)) {
+      if (source == "lr") continue;
+      SCOPED_TRACE(case_name(c) + " " + source);
+      auto [plain, net] = with_and_without(with_rit(spec_for(c), source), {"edge", "history_out"}, &RitSpec::history_blend);
+      auto [color, info] = random_inputs(net->spec(), 7, 5);
+      info.select(1, 5).fill_(1.0f);
+      info.select(1, 6).zero_();
+      info.select(1, 4).copy_(torch::randint(0, 2, info.select(1, 4).sizes()).to(torch::kFloat));
+      torch::NoGradGuard no_grad;
+      auto none = info.clone();
+      none.select(1, 4).zero_();
+      auto other = none.clone();
+      other.slice(1, 1, 4).uniform_(0, 1);
+      EXPECT_TRUE(torch::equal(net->forward(color, none), net->forward(color, other)));
+      EXPECT_TRUE(torch::equal(plain->forward(color, none), plain->forward(color, other)));
+      auto changed = info.clone();
+      changed.slice(1, 1, 4).uniform_(0, 1);
+      EXPECT_FALSE(torch::equal(plain->forward(color, info), plain->forward(color, changed)));
+      EXPECT_FALSE(torch::equal(net->forward(color, info), net->forward(color, changed)));
+
+      net->rit()->blend->bias.fill_(30.0f);
+      const auto valid = info.slice(1, 4, 5).expand({-1, 3, -1, -1}).eq(1);
+      const auto warped = moved_by(info.slice(1, 1, 4), 0, 1);
+      const auto taken = net->forward(color, info);
+      EXPECT_TRUE(torch::allclose(taken.masked_select(valid), warped.masked_select(valid), 1e-5, 1e-5));
+      const auto g = net->describe(/*training=*/true);
+      EXPECT_TRUE(torch::equal(graph::run(g, network_inputs(g, color, info)).front().second,
+                               net->forward_train(color, info).image));
+      const auto deployed = net->describe(/*training=*/false);
+      const auto served = graph::run(deployed, network_inputs(deployed, color, info)).front().second;
+      EXPECT_TRUE(torch::allclose(served.masked_select(valid), warped.masked_select(valid), 1e-5, 1e-5));
+      FusedGraph fused(deployed);
+      const auto fast = fused.run(color, info);
+      EXPECT_TRUE(torch::allclose(fast, served, 1e-4, 1e-4)) << (fast - served).abs().max().item<float>();
+    }
 }
