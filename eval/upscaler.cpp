@@ -130,14 +130,10 @@ void NetworkUpscaler::reset_history() {
 }
 
 torch::Tensor NetworkUpscaler::upscale(const Batch& batch) {
-  auto info = network_->info_input(batch);
   const int frame = batch.frames.size() == 1 ? batch.frames.front() : -1;
   const bool recurs = recurrent();
-  if (recurs) {
-    const bool follows = previous_.defined() && frame >= 0 && frame == previous_frame_ + 1 &&
-                         previous_.size(0) == batch.lr_color.size(0);
-    info = with_previous_output(info, network_->input_channels(), follows ? previous_ : torch::Tensor());
-  }
+  const bool follows = recurs && previous_.defined() && frame >= 0 && frame == previous_frame_ + 1;
+  const auto info = network_->info_input(batch, follows ? previous_ : torch::Tensor());
   torch::Tensor out;
   if (engine_ == InferenceEngine::LibTorch) {
     out = infer(*network_, batch.lr_color, info);

@@ -51,8 +51,8 @@ double max_abs_error(const torch::Tensor& a, const torch::Tensor& b) {
   return diff.max().item<double>();
 }
 
-NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch) {
-  return export_inputs(export_signature(net.describe(false)), batch.lr_color, net.info_input(batch));
+NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch, const torch::Tensor& previous) {
+  return export_inputs(export_signature(net.describe(false)), batch.lr_color, net.info_input(batch, previous));
 }
 
 void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,

@@ -51,7 +51,8 @@ VerifyCase make_verify_case(SRNetworkImpl& net, const ExportedModel& exported,
 
 // The inputs an exported network takes for a rendered batch: lr_color and the model's own
 // rendering channels at the resolution it wants (SRNetworkImpl::info_input).
-NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch);
+// A recurrent network's `previous` output goes in as SRNetworkImpl::info_input takes it.
+NamedTensors inputs_from_batch(const SRNetworkImpl& net, const Batch& batch, const torch::Tensor& previous = {});
 
 // Adds an input set (e.g. a rendered frame, named "frame 12") with our forward pass on it.
 void add_verify_inputs(VerifyCase& c, SRNetworkImpl& net, const NamedTensors& inputs,

@@ -9,6 +9,7 @@
 #include "core/text.h"
 #include "models/backbone_registry.h"
 #include "models/reparameterization.h"
+#include "render_data/history_channel.h"
 
 namespace cgsr {
 
@@ -73,15 +74,16 @@ TrainOutput SRNetworkImpl::forward_train(const torch::Tensor& lr_color, const to
 }
 
 
-torch::Tensor SRNetworkImpl::info_input(const Batch& batch) const {
+torch::Tensor SRNetworkImpl::info_input(const Batch& batch, const torch::Tensor& previous) const {
   if (!has_rit()) return {};
   if (batch.scale != spec_.scale)
     throw Error("batch", "scale x" + std::to_string(batch.scale) + " does not match the model's x" +
                              std::to_string(spec_.scale));
   check_depth_encoding(batch);
   const bool hr = spec_.rit.reads_hr();
-  return pick_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
-                       hr ? "hr_info" : "lr_info", "the model");
+  const auto info = pick_channels(hr ? batch.hr_info : batch.lr_info, batch.channels, input_channels(),
+                                  hr ? "hr_info" : "lr_info", "the model");
+  return with_previous_output(info, input_channels(), previous);
 }
 
 void SRNetworkImpl::check_depth_encoding(const Batch& batch) const {

@@ -43,9 +43,12 @@ class SRNetworkImpl : public torch::nn::Module {
 
   // What the network takes from a Batch: its rendering channels at the resolution the spec asks
   // for (undefined without RIT), and the target of the geometry head (the HR channels). The
-  // batch's depth must be in depth_encoding() (an Error says so otherwise).
+  // batch's depth must be in depth_encoding() (an Error says so otherwise). A recurrent network
+  // (history_out) also takes its output for the frame before, `previous`: with none (the default,
+  // so every reader that knows nothing of it runs the frame alone) the channel's validity is 0
+  // (render_data/history_channel.h with_previous_output).
   DepthEncoding depth_encoding() const { return spec_.rit.depth_encoding; }
-  torch::Tensor info_input(const Batch& batch) const;
+  torch::Tensor info_input(const Batch& batch, const torch::Tensor& previous = {}) const;
   torch::Tensor geometry_target(const Batch& batch) const;
 
   // The inference graph (graph.h): inputs "color" (+ the RIT's "info" or "info_hr"), output

@@ -19,7 +19,6 @@
 #include "models/model_source.h"
 #include "pruning/hybrid_model.h"
 #include "render_data/dataset.h"
-#include "render_data/history_channel.h"
 #include "render_data/patch_sampler.h"
 
 namespace cgsr {
@@ -229,9 +228,8 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
     torch::Tensor previous;
     int previous_frame = -1;
     for (int frame : verification_frames(*data, options.frames)) {
-      Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
+      const Batch b = frame_batch(*data, frame, net->spec().scale, net->input_channels(), net->depth_encoding());
       const bool follows = previous.defined() && previous_frame == frame - 1 && data->has_previous(frame);
-      b.hr_info = with_previous_output(b.hr_info, b.channels, follows ? previous : torch::Tensor());  // read at HR
       const int64_t fw = b.lr_color.size(3), fh = b.lr_color.size(2);
       if (!exported.dynamic_size && (fw != w || fh != h)) {
         // The first test frame is a bonus check; frames asked for must run.
@@ -240,7 +238,8 @@ nlohmann::ordered_json run_export(const ExportCommandOptions& options) {
                                       std::to_string(fh) + " at LR, the file takes " + options.input +
                                       " (--input, or --dynamic-size)");
       }
-      add_verify_inputs(c, *net, inputs_from_batch(*net, b), forward, "frame " + std::to_string(frame));
+      add_verify_inputs(c, *net, inputs_from_batch(*net, b, follows ? previous : torch::Tensor()), forward,
+                        "frame " + std::to_string(frame));
       previous = c.expected.back();
       previous_frame = frame;
     }

@@ -237,8 +237,7 @@ std::pair<TrainOutput, Batch> Trainer::unroll(const Batch& batch) {
   torch::Tensor previous;  // none before a sequence's first frame
   for (int t = 0; t < sequence_; ++t) {
     const Batch step = batch_items(batch, torch::arange(t * n, (t + 1) * n));
-    previous = network_->forward_train(step.lr_color, with_previous_output(network_->info_input(step), channels_, previous))
-                   .image;
+    previous = network_->forward_train(step.lr_color, network_->info_input(step, previous)).image;
     images.push_back(previous);
   }
   std::vector<int64_t> scored;
@@ -259,7 +258,7 @@ TrainOutput Trainer::forward_frame(int frame, int step) {
   const int first = std::max(data_.scene_of(frame).first_frame, frame - kValidationWarmup);
   for (int f = first;; ++f) {
     const Batch b = batch(f);
-    auto out = network_->forward_train(b.lr_color, with_previous_output(network_->info_input(b), channels_, previous));
+    auto out = network_->forward_train(b.lr_color, network_->info_input(b, previous));
     if (f == frame) return out;
     previous = out.image;
   }
