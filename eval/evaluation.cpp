@@ -145,6 +145,18 @@ TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& fram
   return out;
 }
 
+torch::Tensor run_up_to(Upscaler& upscaler, const Dataset& data, int frame, int scale,
+                        const std::vector<RenderChannel>& channels, DepthEncoding depth, int& last_run) {
+  const SceneInfo& scene = data.scene_of(frame);
+  const bool continues = last_run >= scene.first_frame && last_run < frame;
+  if (!continues) upscaler.reset_history();
+  torch::Tensor before;
+  for (int f = continues ? last_run + 1 : scene.first_frame; f < frame; ++f)
+    before = upscaler.upscale(frame_batch(data, f, scale, channels, depth)).clamp(0.0, 1.0);
+  last_run = frame;
+  return before;
+}
+
 EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& options,
                     const std::function<void(const EvalResult&)>& on_quality) {
   if (upscaler.reads_bsp_border() && !data.info().bsp_border)
@@ -176,21 +188,13 @@ EvalResult evaluate(Upscaler& upscaler, const Dataset& data, const EvalOptions& 
   Progress progress("eval " + result.name, static_cast<int64_t>(frames.size()));
   double psnr_sum = 0, ssim_sum = 0;
   int psnr_count = 0;
-  // A recurrent upscaler runs the frames of the scene up to `frame` first, from its first frame or
-  // the last one run; the frame before's output is kept for the temporal error.
+  // A recurrent upscaler runs the frames of the scene up to `frame` first; the frame before's
+  // output is kept for the temporal error.
   int last_run = -1;
   torch::Tensor run_before;
   // Shows a stateful upscaler the frame before `frame` first (see Upscaler::uses_previous_frame).
   const auto upscale_frame = [&](const Batch& b, int frame) {
-    if (upscaler.recurrent()) {
-      const SceneInfo& scene = data.scene_of(frame);
-      const bool continues = last_run >= scene.first_frame && last_run < frame;
-      if (!continues) upscaler.reset_history();
-      run_before = torch::Tensor();
-      for (int f = continues ? last_run + 1 : scene.first_frame; f < frame; ++f)
-        run_before = upscaler.upscale(frame_batch(data, f, result.scale, channels, depth)).clamp(0.0, 1.0);
-      last_run = frame;
-    }
+    if (upscaler.recurrent()) run_before = run_up_to(upscaler, data, frame, result.scale, channels, depth, last_run);
     if (upscaler.uses_previous_frame()) {
       if (data.has_previous(frame))
         upscaler.previous_frame(frame_batch(data, frame - 1, result.scale, channels, depth));

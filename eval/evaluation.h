@@ -97,6 +97,14 @@ struct TimingSequence {
 TimingSequence timing_sequence(const Dataset& data, const std::vector<int>& frames, int scale,
                                const Upscaler& upscaler, int count);
 
+// A recurrent upscaler (Upscaler::recurrent) brought up to `frame`: the frames of its scene before
+// it run in order, from `last_run` + 1 when `last_run` is an earlier frame of that scene (the last
+// frame it ran), else from the scene's first frame after reset_history(). Returns its output for
+// frame - 1 (clamped to [0,1]) when it ran that frame here; `last_run` becomes `frame`. Batches
+// are built with `channels` in `depth`.
+torch::Tensor run_up_to(Upscaler& upscaler, const Dataset& data, int frame, int scale,
+                        const std::vector<RenderChannel>& channels, DepthEncoding depth, int& last_run);
+
 // `on_quality` is called once the quality figures are known, before the latency is measured
 // (which can take minutes at 1080p), so callers can write them out early.
 EvalResult evaluate(Upscaler& upscaler, const Dataset& dataset, const EvalOptions& options,

@@ -210,6 +210,10 @@ ComparisonImage compare_frame(const std::vector<Upscaler*>& networks, const Data
   torch::Tensor truth;
   for (Upscaler* u : all) {
     const TimingSequence frame_only = timing_sequence(data, {frame}, scale, *u, 1);
+    if (u->recurrent()) {  // its state at `frame`: the scene run up to it
+      int last_run = -1;
+      run_up_to(*u, data, frame, scale, u->channels(), u->depth_encoding(), last_run);
+    }
     outputs.push_back(frame_only.run(*u, 0).detach().to(torch::kFloat32).contiguous());
     if (!truth.defined()) truth = frame_only.frames.front().hr_color.to(torch::kFloat32).contiguous();
     if (!torch::isfinite(outputs.back()).all().item<bool>())
