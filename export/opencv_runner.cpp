@@ -51,7 +51,7 @@ std::string opencv_dnn_unsupported_reason(const std::filesystem::path& onnx_file
   for (const auto& [type, count] : info.op_counts)
     if (type == "GridSample")
       return "OpenCV DNN 4.6 has no GridSample layer (ONNX opset 16), which this export samples by offsets with "
-             "(SRPO's projection, rit.skip_at_jitter)";
+             "(SRPO's projection, rit.skip_at_jitter, history_out's warp)";
   return "";
 }
 
