@@ -15,20 +15,12 @@
 #include "eval/report.h"
 #include "render_data/patch_sampler.h"
 #include "tests/support/svg_paths.h"
+#include "tests/support/eval_frames.h"
 #include "tests/support/tiny_data.h"
 
 using namespace cgsr;
 using namespace cgsr::test;
 
-namespace {
-EvalOptions all_frames(const std::string& range) {
-  EvalOptions o;
-  o.split = "all";
-  o.frames = range;
-  o.latency_runs = 0;
-  return o;
-}
-}  // namespace
 
 TEST(Evaluation, FrameRangeSelectsWithinTheSplit) {
   const Dataset data = Dataset::open(tiny_data());

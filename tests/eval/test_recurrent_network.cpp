@@ -3,18 +3,17 @@
 // the exported file reproduced by ONNX Runtime over a sequence that crosses the cut.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <limits>
-#include <sstream>
 
-#include "eval/evaluation.h"
 #include "core/image_io.h"
+#include "eval/evaluation.h"
 #include "eval/upscaler.h"
 #include "models/graph.h"
 #include "models/model_file.h"
 #include "render_data/history_channel.h"
 #include "render_data/patch_sampler.h"
 #include "tests/support/cli_runner.h"
+#include "tests/support/eval_frames.h"
 #include "tests/support/scratch_dir.h"
 #include "tests/support/tiny_data.h"
 
@@ -25,26 +24,9 @@ namespace fs = std::filesystem;
 using test::run_cgsr;
 using test::with_channels;
 
-// The tiny scene (6 frames), then again with its camera walk spread over 24 frames so that most
-// of a frame stays in view of the next: the cut is at frame 6.
-const fs::path& two_scene_walk() {
-  static const fs::path set = [] {
-    const fs::path dir = test::scratch_dir("recurrent-scenes");
-    std::ostringstream text;
-    text << std::ifstream(std::string(CGSR_SOURCE_DIR) + "/configs/scenes/tiny.yaml").rdbuf();
-    std::string b = text.str();
-    const auto at_name = b.find("name: tiny\nframes: 6");
-    EXPECT_NE(at_name, std::string::npos);
-    std::string a = b;
-    a.replace(at_name, 20, "name: tiny_a\nframes: 6");
-    b.replace(at_name, 20, "name: tiny_b\nframes: 24");
-    std::ofstream(dir / "tiny_a.yaml") << a;
-    std::ofstream(dir / "tiny_b.yaml") << b;
-    const auto r = run_cgsr("render --scene " + (dir / "tiny_a.yaml").string() + " --scene " + (dir / "tiny_b.yaml").string() +
-                            " --threads 1 --out " + (dir / "set").string());
-    EXPECT_EQ(r.exit_code, 0) << r.all();
-    return dir / "set";
-  }();
+// The tiny scene, then its walk over 24 frames: the cut is at frame 6.
+const fs::path& walk_set() {
+  static const fs::path set = test::two_scene_walk("recurrent-scenes");
   return set;
 }
 constexpr int kCut = 6;
@@ -62,8 +44,8 @@ torch::Tensor at(const torch::Tensor& image, const torch::Tensor& mask) {
 // output) reproduces frame t where the channel says valid, far better than frame t-1 unwarped;
 // what the depth test rejects is farther from the truth; a scene's first frame has no valid pixel.
 TEST(RecurrentNetwork, TheChannelsWarpReproducesTheNextFrameWhereValid) {
-  const Dataset all = Dataset::open(two_scene_walk());
-  const Dataset data = Dataset::open(two_scene_walk(), with_channels({"history_out"}));
+  const Dataset all = Dataset::open(walk_set());
+  const Dataset data = Dataset::open(walk_set(), with_channels({"history_out"}));
   const size_t hr = 1;
   EXPECT_EQ(data.frame(kCut, hr)->history_out[3].sum().item<float>(), 0.0f);
   EXPECT_EQ(data.frame(0, hr)->history_out[3].sum().item<float>(), 0.0f);
@@ -108,7 +90,7 @@ TEST(RecurrentNetwork, TheChannelsWarpReproducesTheNextFrameWhereValid) {
 // Sequences: T consecutive frames of one scene per item, step t's items at t * N, the drawn frame
 // among them; the validity ends where the motion leaves the window; T = 1 draws what it always did.
 TEST(RecurrentNetwork, TheSamplerDrawsSequencesInOneScene) {
-  const Dataset data = Dataset::open(two_scene_walk(), with_channels({"history_out"}));
+  const Dataset data = Dataset::open(walk_set(), with_channels({"history_out"}));
   PatchSamplerOptions o;
   o.patch_size = 12;
   o.batch_size = 6;
@@ -169,20 +151,13 @@ class RecordingRecurrent : public Upscaler {
   std::unique_ptr<Upscaler> bicubic_ = classic_upscalers().get("bicubic")(2);
 };
 
-EvalOptions frames(const std::string& range) {
-  EvalOptions o;
-  o.split = "all";
-  o.frames = range;
-  o.latency_runs = 0;
-  return o;
-}
 
 // Evaluation runs a recurrent upscaler over every frame of a scene from its first, in order,
 // though it scores only the range; at the cut it starts again.
 TEST(RecurrentNetwork, EvaluationRunsEachSceneInOrderFromItsFirstFrame) {
-  const Dataset data = Dataset::open(two_scene_walk());
+  const Dataset data = Dataset::open(walk_set());
   RecordingRecurrent recording;
-  const EvalResult r = evaluate(recording, data, frames("3:9"));
+  const EvalResult r = evaluate(recording, data, test::all_frames("3:9"));
   const int reset = RecordingRecurrent::kReset;
   EXPECT_EQ(recording.seen, (std::vector<int>{reset, 0, 1, 2, 3, 4, 5, reset, 6, 7, 8}));
   ASSERT_EQ(r.frames.size(), 6u);
@@ -195,7 +170,7 @@ TEST(RecurrentNetwork, EvaluationRunsEachSceneInOrderFromItsFirstFrame) {
 // reproduces the exported file over 8 frames across the cut, each fed cgsr's previous output.
 TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
   const auto dir = test::scratch_dir("recurrent-train");
-  const auto train = run_cgsr("train --data " + two_scene_walk().string() +
+  const auto train = run_cgsr("train --data " + walk_set().string() +
                               " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
                               " --set schedule.val_frames=1 --set enhance.enabled=true"
                               " --set 'enhance.rit.channels=[depth, history_out]' --set enhance.rit.history_blend=true"
@@ -204,9 +179,9 @@ TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
   ASSERT_EQ(train.exit_code, 0) << train.all();
   const fs::path model = dir / "train" / "model.cgsr";
 
-  const Dataset data = open_for_channels(two_scene_walk(), {RenderChannel::Depth, RenderChannel::HistoryOut});
+  const Dataset data = open_for_channels(walk_set(), {RenderChannel::Depth, RenderChannel::HistoryOut});
   const auto saved = [&](const std::string& name) {
-    EvalOptions o = frames("4:12");
+    EvalOptions o = test::all_frames("4:12");
     o.temporal = false;
     o.save_frames = (dir / name).string();
     NetworkUpscaler net("recurrent", load_model(model).network);
@@ -231,7 +206,7 @@ TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
   EXPECT_FALSE(torch::equal(read("a", kCut + 3), quantized(alone(kCut + 3))));
 
   const auto exported = run_cgsr("export --model " + model.string() + " --format onnx --input 64x48 --verify --data " +
-                                 two_scene_walk().string() + " --frames 2:10 --out " + (dir / "model.onnx").string());
+                                 walk_set().string() + " --frames 2:10 --out " + (dir / "model.onnx").string());
   ASSERT_EQ(exported.exit_code, 0) << exported.all();
   EXPECT_NE(exported.out.find("0 failed"), std::string::npos) << exported.out;
   EXPECT_NE(exported.out.find("frame 9 (64x48)"), std::string::npos) << exported.out;
@@ -242,7 +217,7 @@ TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
 // an HR output: each a clear error naming the key.
 TEST(RecurrentNetwork, ItsSettingsAreCheckedWithClearErrors) {
   const auto dir = test::scratch_dir("recurrent-errors");
-  const std::string base = "train --data " + two_scene_walk().string() +
+  const std::string base = "train --data " + walk_set().string() +
                            " --model pan --steps 1 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
                            " --set schedule.val_frames=1 --set enhance.enabled=true --set enhance.geometry.enabled=false ";
   const auto one = run_cgsr(base + "--set 'enhance.rit.channels=[history_out]' --set enhance.rit.source=hr_fuse"

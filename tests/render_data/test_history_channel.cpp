@@ -202,24 +202,7 @@ TEST(HistoryChannel, WarpingReproducesTheFrameAndRejectsDisocclusions) {
 // The tiny scene twice, jittered (unjittered, a frame's own samples fill every HR pixel at s = 2):
 // 6 frames, then a slower walk of 24 so that samples stay in view. The cut is at frame 6.
 const fs::path& two_scene_data() {
-  static const fs::path set = [] {
-    const fs::path dir = test::scratch_dir("history-scenes");
-    std::ostringstream text;
-    text << std::ifstream(tiny_config()).rdbuf();
-    std::string b = text.str();
-    const auto at_name = b.find("name: tiny\nframes: 6");
-    EXPECT_NE(at_name, std::string::npos);
-    b += "\njitter: {sequence: halton, phases: 16}\n";
-    std::string a = b;
-    a.replace(at_name, 20, "name: tiny_a\nframes: 6");
-    b.replace(at_name, 20, "name: tiny_b\nframes: 24");
-    std::ofstream(dir / "tiny_a.yaml") << a;
-    std::ofstream(dir / "tiny_b.yaml") << b;
-    const auto r = test::run_cgsr("render --scene " + (dir / "tiny_a.yaml").string() + " --scene " +
-                                  (dir / "tiny_b.yaml").string() + " --threads 1 --out " + (dir / "set").string());
-    EXPECT_EQ(r.exit_code, 0) << r.all();
-    return dir / "set";
-  }();
+  static const fs::path set = test::two_scene_walk("history-scenes", "\njitter: {sequence: halton, phases: 16}\n");
   return set;
 }
 
