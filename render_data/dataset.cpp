@@ -344,20 +344,22 @@ struct Dataset::Impl {
     return f;
   }
 
-  // Frame `frame`'s depth and motion at resolution `res`: as stored there, or, for a capture that
-  // stores them at the render size only, the LR ones upsampled as an engine passes them. The LR
-  // frame read for that (with its depth) is left in `lr`, so the samples need not read it again.
-  Frame depth_and_motion(int frame, size_t res, Frame& lr) const {
+  // Frame `frame`'s depth and motion (or only the `wanted` of them) at resolution `res`: as stored
+  // there, or, for a capture that stores them at the render size only, the LR ones upsampled as an
+  // engine passes them. The LR frame read for that (with its depth) is left in `lr`, so the samples
+  // need not read it again.
+  Frame depth_and_motion(int frame, size_t res, Frame& lr,
+                         const std::vector<RenderChannel>& wanted = {RenderChannel::Depth, RenderChannel::Motion}) const {
     const auto& here = info.stored_at[res];
     std::vector<RenderChannel> stored_here, from_lr;
-    for (auto c : {RenderChannel::Depth, RenderChannel::Motion})
-      (std::find(here.begin(), here.end(), c) != here.end() ? stored_here : from_lr).push_back(c);
+    for (auto c : wanted) (std::find(here.begin(), here.end(), c) != here.end() ? stored_here : from_lr).push_back(c);
     Frame out = stored_here.empty() ? Frame() : source->load(frame, res, stored_here);
     if (from_lr.empty()) return out;
-    lr = source->load(frame, 0, {RenderChannel::Depth, RenderChannel::Motion});
+    lr = source->load(frame, 0, wanted);
     const int scale = lr_multiple(info, res);
-    if (!out.depth.defined()) out.depth = upsample_channel(lr.depth, RenderChannel::Depth, scale);
-    if (!out.motion.defined()) out.motion = upsample_channel(lr.motion, RenderChannel::Motion, scale);
+    if (!out.depth.defined() && lr.depth.defined()) out.depth = upsample_channel(lr.depth, RenderChannel::Depth, scale);
+    if (!out.motion.defined() && lr.motion.defined())
+      out.motion = upsample_channel(lr.motion, RenderChannel::Motion, scale);
     return out;
   }
 
@@ -395,7 +397,9 @@ struct Dataset::Impl {
     Frame lr;
     const Frame here = f.depth.defined() && f.motion.defined() ? f : depth_and_motion(index, res, lr);
     torch::Tensor previous_depth;
-    if (has_previous_frame(info, index)) previous_depth = depth_and_motion(index - 1, res, lr).depth;
+    Frame previous_lr;
+    if (has_previous_frame(info, index))
+      previous_depth = depth_and_motion(index - 1, res, previous_lr, {RenderChannel::Depth}).depth;
     return history_out_channel(here.depth, here.motion, previous_depth,
                                info.root.string() + ": frame " + std::to_string(index) + " at " + info.resolutions[res].name());
   }
