@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <set>
+
 #include "core/atomic_file.h"
 #include "core/yaml_json.h"
 #include "eval/relative_latency.h"
@@ -15,11 +17,34 @@ namespace cgsr {
 config::Schema<ControlsOptions> controls_schema() {
   config::Schema<ControlsOptions> s;
   s.field("kinds", &ControlsOptions::kinds, "controls cut to the final network's latency: magnitude (MMP), uniform");
+  s.field("latency_factors", &ControlsOptions::latency_factors,
+          "latencies each kind is cut to, as multiples of the final network's (1: equal latency)");
+  s.validate([](const ControlsOptions& o, const config::Cursor& at, const YAML::Node& node) {
+    if (o.latency_factors.empty()) at.child("latency_factors").fail(node["latency_factors"], "must list a factor");
+    std::set<double> seen;
+    for (double f : o.latency_factors) {
+      if (!(f > 0 && f <= 4))
+        at.child("latency_factors").fail(node["latency_factors"], fmt::format("{:g} is not in (0, 4]", f));
+      if (!seen.insert(f).second)
+        at.child("latency_factors").fail(node["latency_factors"], fmt::format("{:g} is listed twice", f));
+    }
+  });
   return s;
 }
 
+
 namespace {
 constexpr int kTimedRuns = 7;  // interleaved rounds per control timed
+
+// The control's file stem: its kind, and its latency factor when that is not 1.
+std::string control_stem(ControlKind kind, double latency_factor) {
+  return enum_name(kind) + (latency_factor == 1.0 ? "" : fmt::format("_x{:g}", latency_factor));
+}
+
+// Its display name: the factor is said when it is not 1.
+std::string control_name(const std::string& base, ControlKind kind, double latency_factor) {
+  return base + " " + control_label(kind) + (latency_factor == 1.0 ? "" : fmt::format(" at {:g}x", latency_factor));
+}
 }  // namespace
 
 nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, bool resume) {
@@ -41,41 +66,45 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
   results["latency_of"] = job.final_model;
   results["controls"] = nlohmann::ordered_json::array();
   for (const ControlKind kind : job.options.kinds) {
-    const std::string name = base + " " + control_label(kind);
-    const std::string stem = enum_name(kind);
-    // The cut is kept: timings differ between runs, and a resumed fine-tuning needs its network.
-    const auto cut_file = run_dir.file("cut_" + stem + ".json");
-    ControlNetwork control;
-    if (resume && std::filesystem::exists(cut_file)) {
-      const auto cut = nlohmann::json::parse(read_file(cut_file));
-      const double cost = cut.at("latency_fraction").get<double>();
-      control = control_at_rate(*enhanced.network, kind, cut.at("keep_rate").get<double>(),
-                                [&](const SRNetwork&) { return cost; });
-    } else {
-      control = control_at_latency(*enhanced.network, kind, 1.0, fraction);
-      write_file_atomic(cut_file,
-                        nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
+    for (const double factor : job.options.latency_factors) {
+      const std::string name = control_name(base, kind, factor);
+      const std::string stem = control_stem(kind, factor);
+      // The cut is kept: timings differ between runs, and a resumed fine-tuning needs its network.
+      const auto cut_file = run_dir.file("cut_" + stem + ".json");
+      ControlNetwork control;
+      if (resume && std::filesystem::exists(cut_file)) {
+        const auto cut = nlohmann::json::parse(read_file(cut_file));
+        const double cost = cut.at("latency_fraction").get<double>();
+        control = control_at_rate(*enhanced.network, kind, cut.at("keep_rate").get<double>(),
+                                  [&](const SRNetwork&) { return cost; });
+      } else {
+        control = control_at_latency(*enhanced.network, kind, factor, fraction);
+        write_file_atomic(cut_file,
+                          nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
+      }
+      spdlog::info("{}: keep rate {:.3f}, {:.2f}x {}'s latency; fine-tuning {} steps", name, control.rate, control.cost,
+                   final_name, job.schedule.steps);
+      TrainHooks hooks;
+      if (job.distill > 0) hooks = distillation_hooks(load_model(job.enhanced).network, job.distill, job.loss.image_norm);
+      Trainer trainer(control.network, data, job.schedule, job.loss, {}, hooks);
+      const TrainOutcome outcome = trainer.run(run_dir.file("finetune_" + stem + ".pt"), resume);
+      Provenance p;
+      p.stage = "control";
+      p.parent = job.enhanced;
+      p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
+      p.extra = {{"name", name}, {"data", data.info().root.string()}, {"control", enum_name(kind)},
+                 {"latency_factor", factor}, {"keep_rate", control.rate}};
+      const auto file = run_dir.file(stem + ".cgsr");
+      save_model(file, *control.network, p);
+      results["controls"].push_back({{"kind", enum_name(kind)},
+                                     {"latency_factor", factor},
+                                     {"name", name},
+                                     {"file", file.string()},
+                                     {"keep_rate", control.rate},
+                                     {"latency_fraction", control.cost},
+                                     {"spec", spec_summary(control.network->spec())},
+                                     {"training", to_json(outcome)}});
     }
-    spdlog::info("{}: keep rate {:.3f}, {:.2f}x {}'s latency; fine-tuning {} steps", name, control.rate, control.cost,
-                 final_name, job.schedule.steps);
-    TrainHooks hooks;
-    if (job.distill > 0) hooks = distillation_hooks(load_model(job.enhanced).network, job.distill, job.loss.image_norm);
-    Trainer trainer(control.network, data, job.schedule, job.loss, {}, hooks);
-    const TrainOutcome outcome = trainer.run(run_dir.file("finetune_" + stem + ".pt"), resume);
-    Provenance p;
-    p.stage = "control";
-    p.parent = job.enhanced;
-    p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
-    p.extra = {{"name", name}, {"data", data.info().root.string()}, {"control", stem}, {"keep_rate", control.rate}};
-    const auto file = run_dir.file(stem + ".cgsr");
-    save_model(file, *control.network, p);
-    results["controls"].push_back({{"kind", stem},
-                                   {"name", name},
-                                   {"file", file.string()},
-                                   {"keep_rate", control.rate},
-                                   {"latency_fraction", control.cost},
-                                   {"spec", spec_summary(control.network->spec())},
-                                   {"training", to_json(outcome)}});
   }
   return results;
 }

@@ -4,9 +4,11 @@
 // magnitude to the final network's latency, timed against it as the report times its rows
 // (eval/relative_latency.h): the pruning units alone (MMP), or every layer group alike (uniform
 // width). Each control is then fine-tuned like the final network: the same schedule and the same
-// distillation weight, its teacher the CG-enhanced network it was cut from. Writes <kind>.cgsr
-// and cut_<kind>.json (the rate, kept for a resumed run) per control, and results.json
-// (`controls`: name, file, keep rate, latency as a fraction of the final network's).
+// distillation weight, its teacher the CG-enhanced network it was cut from. Each kind is cut to
+// each of `latency_factors` times the final network's latency (1: equal latency; more factors
+// draw each control's PSNR-latency curve in the report). Writes <kind>.cgsr and cut_<kind>.json
+// (the rate, kept for a resumed run) per control, <kind>_x<factor> for factors other than 1, and
+// results.json (`controls`: name, file, keep rate, latency as a fraction of the final network's).
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -23,6 +25,7 @@ namespace cgsr {
 
 struct ControlsOptions {
   std::vector<ControlKind> kinds = {ControlKind::Magnitude, ControlKind::Uniform};
+  std::vector<double> latency_factors = {1.0};  // latencies cut to, as multiples of the final network's
 };
 config::Schema<ControlsOptions> controls_schema();
 

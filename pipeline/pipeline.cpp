@@ -360,7 +360,10 @@ class Pipeline {
     if (!options_.controls.kinds.empty()) {
       std::vector<std::string> kinds;
       for (auto k : options_.controls.kinds) kinds.push_back(control_label(k));
-      line("controls", join(kinds) + " at the CG-optimized network's latency, " + schedule(search_.final.schedule));
+      std::vector<std::string> factors;
+      for (double f : options_.controls.latency_factors) factors.push_back(fmt::format("{:g}x", f));
+      line("controls", join(kinds) + " at " + join(factors) + " the CG-optimized network's latency, " +
+                           schedule(search_.final.schedule));
     }
     std::vector<std::string> formats;
     for (auto f : options_.export_formats) formats.push_back(enum_name(f));
