@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <set>
 
 #include "core/atomic_file.h"
@@ -34,7 +35,8 @@ config::Schema<ControlsOptions> controls_schema() {
 
 
 namespace {
-constexpr int kTimedRuns = 7;  // interleaved rounds per control timed
+constexpr int kTimedRuns = 7;      // interleaved rounds per control timed
+constexpr double kReached = 1.05;  // a cut within 5% of its latency target reaches it (timing noise)
 
 // The control's file stem: its kind, and its latency factor when that is not 1.
 std::string control_stem(ControlKind kind, double latency_factor) {
@@ -65,8 +67,13 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
   nlohmann::ordered_json results;
   results["latency_of"] = job.final_model;
   results["controls"] = nlohmann::ordered_json::array();
+  // Equal latency first: when a kind cannot be cut as far as a smaller factor asks, that cut is
+  // the same network, kept once under the equal-latency control's name.
+  std::vector<double> factors = job.options.latency_factors;
+  std::stable_partition(factors.begin(), factors.end(), [](double f) { return f == 1.0; });
   for (const ControlKind kind : job.options.kinds) {
-    for (const double factor : job.options.latency_factors) {
+    std::set<double> rates_cut;
+    for (const double factor : factors) {
       const std::string name = control_name(base, kind, factor);
       const std::string stem = control_stem(kind, factor);
       // The cut is kept: timings differ between runs, and a resumed fine-tuning needs its network.
@@ -82,6 +89,14 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
         write_file_atomic(cut_file,
                           nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
       }
+      if (!rates_cut.insert(control.rate).second) {
+        spdlog::warn("{}: the same cut as another {} control (keep rate {:.3f}, {:.2f}x {}'s latency); not trained "
+                     "again", name, control_label(kind), control.rate, control.cost, final_name);
+        continue;
+      }
+      if (control.cost > factor * kReached)
+        spdlog::warn("{}: its narrowest cut runs at {:.2f}x {}'s latency, above the {:g}x asked for", name,
+                     control.cost, final_name, factor);
       spdlog::info("{}: keep rate {:.3f}, {:.2f}x {}'s latency; fine-tuning {} steps", name, control.rate, control.cost,
                    final_name, job.schedule.steps);
       TrainHooks hooks;

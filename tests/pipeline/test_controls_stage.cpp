@@ -1,6 +1,9 @@
 // The controls stage cuts each kind to each latency factor of the final network: one control per
-// pair, named and filed by its factor, narrower for a smaller factor, its cut kept for a resumed run.
+// pair, named and filed by its factor, narrower for a smaller factor, never the same cut twice,
+// its cut kept for a resumed run.
 #include <gtest/gtest.h>
+
+#include <set>
 
 #include "core/config.h"
 #include "core/error.h"
@@ -43,7 +46,8 @@ TEST(ControlsStage, CutsEachKindToEachLatencyFactor) {
   save_model(dir / "final.cgsr", *half.network);
 
   ControlsJob job;
-  job.options = parse_controls("kinds: [uniform]\nlatency_factors: [0.5, 1]\n");
+  // 0.25 and 0.5 may both reach the narrowest cut on this tiny network; it is trained once.
+  job.options = parse_controls("kinds: [uniform]\nlatency_factors: [0.5, 0.25, 1]\n");
   job.enhanced = (dir / "enhanced.cgsr").string();
   job.final_model = (dir / "final.cgsr").string();
   job.data = test::tiny_data().string();
@@ -57,9 +61,11 @@ TEST(ControlsStage, CutsEachKindToEachLatencyFactor) {
     return run_controls(job, run_dir, resume);
   };
   const auto first = run(false);
-  ASSERT_EQ(first["controls"].size(), 2u);
-  const auto& at_half = first["controls"][0];
-  const auto& at_one = first["controls"][1];
+  const auto& controls = first["controls"];
+  ASSERT_GE(controls.size(), 2u);
+  ASSERT_LE(controls.size(), 3u);
+  const auto& at_one = controls[0];  // equal latency first
+  const auto& at_half = controls[1];
   EXPECT_EQ(at_half["name"], "tiny CG uniform width at 0.5x");
   EXPECT_EQ(at_one["name"], "tiny CG uniform width");
   EXPECT_DOUBLE_EQ(at_half["latency_factor"].get<double>(), 0.5);
@@ -68,9 +74,12 @@ TEST(ControlsStage, CutsEachKindToEachLatencyFactor) {
   // A smaller latency keeps no more of the network (timings are noisy; the order is not).
   EXPECT_LE(at_half["keep_rate"].get<double>(), at_one["keep_rate"].get<double>());
   EXPECT_EQ(read_model_file(at_half["file"].get<std::string>()).provenance.extra["latency_factor"], 0.5);
+  std::set<double> rates;
+  for (const auto& c : controls) EXPECT_TRUE(rates.insert(c["keep_rate"].get<double>()).second) << c.dump();
 
   // Resumed, each control is cut where its kept cut says, not timed again.
   const auto resumed = run(true);
-  for (size_t i = 0; i < 2; ++i)
-    EXPECT_EQ(resumed["controls"][i]["keep_rate"], first["controls"][i]["keep_rate"]) << i;
+  ASSERT_EQ(resumed["controls"].size(), controls.size());
+  for (size_t i = 0; i < controls.size(); ++i)
+    EXPECT_EQ(resumed["controls"][i]["keep_rate"], controls[i]["keep_rate"]) << i;
 }
