@@ -33,7 +33,6 @@ config::Schema<ControlsOptions> controls_schema() {
   return s;
 }
 
-
 namespace {
 constexpr int kTimedRuns = 7;      // interleaved rounds per control timed
 constexpr double kReached = 1.05;  // a cut within 5% of its latency target reaches it (timing noise)
