@@ -46,6 +46,48 @@ std::string control_stem(ControlKind kind, double latency_factor) {
 std::string control_name(const std::string& base, ControlKind kind, double latency_factor) {
   return base + " " + control_label(kind) + (latency_factor == 1.0 ? "" : fmt::format(" at {:g}x", latency_factor));
 }
+
+// The control of `kind` at `factor` times the final network's latency: cut by timing, or, in a
+// resumed run, where its kept cut says. The cut is kept: timings differ between runs, and a
+// resumed fine-tuning needs its network.
+ControlNetwork cut_control(const SRNetworkImpl& enhanced, ControlKind kind, double factor, const NetworkCost& fraction,
+                           const std::filesystem::path& cut_file, bool resume) {
+  if (resume && std::filesystem::exists(cut_file)) {
+    const auto cut = nlohmann::json::parse(read_file(cut_file));
+    const double cost = cut.at("latency_fraction").get<double>();
+    return control_at_rate(enhanced, kind, cut.at("keep_rate").get<double>(), [&](const SRNetwork&) { return cost; });
+  }
+  ControlNetwork control = control_at_latency(enhanced, kind, factor, fraction);
+  write_file_atomic(cut_file,
+                    nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
+  return control;
+}
+
+// Fine-tunes the control like the final network and saves it as <stem>.cgsr; its results entry.
+nlohmann::ordered_json finetune_control(const ControlsJob& job, const Dataset& data, RunDir& run_dir, bool resume,
+                                        const ControlNetwork& control, ControlKind kind, double factor,
+                                        const std::string& name, const std::string& stem) {
+  TrainHooks hooks;
+  if (job.distill > 0) hooks = distillation_hooks(load_model(job.enhanced).network, job.distill, job.loss.image_norm);
+  Trainer trainer(control.network, data, job.schedule, job.loss, {}, hooks);
+  const TrainOutcome outcome = trainer.run(run_dir.file("finetune_" + stem + ".pt"), resume);
+  Provenance p;
+  p.stage = "control";
+  p.parent = job.enhanced;
+  p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
+  p.extra = {{"name", name}, {"data", data.info().root.string()}, {"control", enum_name(kind)},
+             {"latency_factor", factor}, {"keep_rate", control.rate}};
+  const auto file = run_dir.file(stem + ".cgsr");
+  save_model(file, *control.network, p);
+  return {{"kind", enum_name(kind)},
+          {"latency_factor", factor},
+          {"name", name},
+          {"file", file.string()},
+          {"keep_rate", control.rate},
+          {"latency_fraction", control.cost},
+          {"spec", spec_summary(control.network->spec())},
+          {"training", to_json(outcome)}};
+}
 }  // namespace
 
 nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, bool resume) {
@@ -75,19 +117,8 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
     for (const double factor : factors) {
       const std::string name = control_name(base, kind, factor);
       const std::string stem = control_stem(kind, factor);
-      // The cut is kept: timings differ between runs, and a resumed fine-tuning needs its network.
-      const auto cut_file = run_dir.file("cut_" + stem + ".json");
-      ControlNetwork control;
-      if (resume && std::filesystem::exists(cut_file)) {
-        const auto cut = nlohmann::json::parse(read_file(cut_file));
-        const double cost = cut.at("latency_fraction").get<double>();
-        control = control_at_rate(*enhanced.network, kind, cut.at("keep_rate").get<double>(),
-                                  [&](const SRNetwork&) { return cost; });
-      } else {
-        control = control_at_latency(*enhanced.network, kind, factor, fraction);
-        write_file_atomic(cut_file,
-                          nlohmann::json{{"keep_rate", control.rate}, {"latency_fraction", control.cost}}.dump() + "\n");
-      }
+      const ControlNetwork control =
+          cut_control(*enhanced.network, kind, factor, fraction, run_dir.file("cut_" + stem + ".json"), resume);
       if (!rates_cut.insert(control.rate).second) {
         spdlog::warn("{}: the same cut as another {} control (keep rate {:.3f}, {:.2f}x {}'s latency); not trained "
                      "again", name, control_label(kind), control.rate, control.cost, final_name);
@@ -98,26 +129,7 @@ nlohmann::ordered_json run_controls(const ControlsJob& job, RunDir& run_dir, boo
                      control.cost, final_name, factor);
       spdlog::info("{}: keep rate {:.3f}, {:.2f}x {}'s latency; fine-tuning {} steps", name, control.rate, control.cost,
                    final_name, job.schedule.steps);
-      TrainHooks hooks;
-      if (job.distill > 0) hooks = distillation_hooks(load_model(job.enhanced).network, job.distill, job.loss.image_norm);
-      Trainer trainer(control.network, data, job.schedule, job.loss, {}, hooks);
-      const TrainOutcome outcome = trainer.run(run_dir.file("finetune_" + stem + ".pt"), resume);
-      Provenance p;
-      p.stage = "control";
-      p.parent = job.enhanced;
-      p.metrics = {{"val_psnr", outcome.best.psnr}, {"val_ssim", outcome.best.ssim}};
-      p.extra = {{"name", name}, {"data", data.info().root.string()}, {"control", enum_name(kind)},
-                 {"latency_factor", factor}, {"keep_rate", control.rate}};
-      const auto file = run_dir.file(stem + ".cgsr");
-      save_model(file, *control.network, p);
-      results["controls"].push_back({{"kind", enum_name(kind)},
-                                     {"latency_factor", factor},
-                                     {"name", name},
-                                     {"file", file.string()},
-                                     {"keep_rate", control.rate},
-                                     {"latency_fraction", control.cost},
-                                     {"spec", spec_summary(control.network->spec())},
-                                     {"training", to_json(outcome)}});
+      results["controls"].push_back(finetune_control(job, data, run_dir, resume, control, kind, factor, name, stem));
     }
   }
   return results;
