@@ -9,9 +9,9 @@
 // draw each control's PSNR-latency curve in the report); the equal-latency cut comes first, and a
 // cut that is the same network as an earlier one of its kind (MMP, which keeps the residual stream
 // whole, cannot run much faster than the network it is matched to) is not trained again. Writes
-// <kind>.cgsr and cut_<kind>.json
-// (the rate, kept for a resumed run) per control, <kind>_x<factor> for factors other than 1, and
-// results.json (`controls`: name, file, keep rate, latency as a fraction of the final network's).
+// <kind>.cgsr and cut_<kind>.json (the rate, kept for a resumed run) per control, <kind>_x<factor>
+// for factors other than 1, and results.json (`controls`: name, file, keep rate, latency as a
+// fraction of the final network's).
 
 #include <nlohmann/json.hpp>
 #include <string>

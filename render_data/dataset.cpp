@@ -357,9 +357,10 @@ struct Dataset::Impl {
     if (from_lr.empty()) return out;
     lr = source->load(frame, 0, wanted);
     const int scale = lr_multiple(info, res);
-    if (!out.depth.defined() && lr.depth.defined()) out.depth = upsample_channel(lr.depth, RenderChannel::Depth, scale);
-    if (!out.motion.defined() && lr.motion.defined())
-      out.motion = upsample_channel(lr.motion, RenderChannel::Motion, scale);
+    for (auto c : from_lr) {
+      const bool depth = c == RenderChannel::Depth;
+      (depth ? out.depth : out.motion) = upsample_channel(depth ? lr.depth : lr.motion, c, scale);
+    }
     return out;
   }
 
