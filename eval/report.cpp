@@ -169,9 +169,10 @@ std::string report_csv(const std::vector<ReportTable>& tables) {
   return csv.str();
 }
 
-ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles) {
+ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles, bool networks_only) {
   ScatterPlot plot;
-  plot.title = table.dataset + " x" + std::to_string(table.scale) + ": PSNR against latency";
+  plot.title = table.dataset + " x" + std::to_string(table.scale) + ": PSNR against latency" +
+               (networks_only ? ", the networks" : "");
   plot.x_label = "latency (ms, median, log scale)";
   plot.y_label = "PSNR (dB)";
   plot.log_x = true;
@@ -183,25 +184,44 @@ ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles) {
   PlotSeries control{"control", {40, 90, 180}, 5, false, Marker::Square, false, {}};
   PlotSeries final_net{"final network", {210, 40, 40}, 6.5, false, Marker::Diamond, true, {}};
   PlotSeries front{"Pareto front", {210, 40, 40}, 0, true, Marker::Circle, true, {}};
+  // Hollow like the other controls; colours and markers apart from every other series.
+  static const Rgb kCurveColours[] = {{0, 140, 130}, {150, 70, 170}, {220, 130, 20}};
+  static const Marker kCurveMarkers[] = {Marker::Square, Marker::Triangle, Marker::Circle};
+  std::vector<PlotSeries> curves;
+  std::map<std::string, std::pair<size_t, std::string>> on_curve;  // row name -> (curve, label)
+  for (size_t c = 0; c < roles.curves.size(); ++c) {
+    curves.push_back({roles.curves[c].name, kCurveColours[c % 3], 5, true, kCurveMarkers[c % 3], false, {}});
+    for (const auto& [row, label] : roles.curves[c].points) on_curve[row] = {c, label};
+  }
   std::map<std::string, std::pair<double, double>> at;  // row name -> (latency, PSNR)
-  const auto on_front = pareto_front(table);
-  for (size_t i = 0; i < table.rows.size(); ++i) {
-    const auto& r = table.rows[i];
+  ReportTable shown = table;
+  if (networks_only)
+    shown.rows.erase(std::remove_if(shown.rows.begin(), shown.rows.end(), [](const EvalResult& r) { return !r.cost; }),
+                     shown.rows.end());
+  const auto on_front = pareto_front(shown);
+  for (size_t i = 0; i < shown.rows.size(); ++i) {
+    const auto& r = shown.rows[i];
     if (!r.latency) {
       plot.horizontal_lines.emplace_back(r.psnr, r.name + " (no latency)");
       continue;
     }
     const PlotPoint p{r.latency->median_ms, r.psnr, r.name};
     at[r.name] = {p.x, p.y};
-    (named(roles.finals, r.name) ? final_net : named(roles.controls, r.name) ? control : !r.cost ? classic : network)
-        .points.push_back(p);
+    if (const auto curve = on_curve.find(r.name); curve != on_curve.end())
+      curves[curve->second.first].points.push_back({p.x, p.y, curve->second.second});
+    else
+      (named(roles.finals, r.name) ? final_net : named(roles.controls, r.name) ? control : !r.cost ? classic : network)
+          .points.push_back(p);
     if (std::find(on_front.begin(), on_front.end(), i) != on_front.end()) front.points.push_back({p.x, p.y, ""});
   }
   for (const auto& [a, b] : roles.pairs)
     if (at.count(a) && at.count(b)) plot.links.push_back({at[a].first, at[a].second, at[b].first, at[b].second});
   plot.links_name = "a network and its control";
-  for (auto* s : {&front, &classic, &network, &control, &final_net})
+  for (auto* s : {&front, &classic, &network, &control})
     if (!s->points.empty()) plot.series.push_back(*s);
+  for (const auto& s : curves)
+    if (!s.points.empty()) plot.series.push_back(s);
+  if (!final_net.points.empty()) plot.series.push_back(final_net);  // drawn last: on top
   return plot;
 }
 
@@ -250,11 +270,22 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
                   "latency is the run's own table's).\n\n";
     markdown += report_markdown(t) + "\n";
     // A plot of PSNR against latency needs a latency (held-out scenes are evaluated for quality only).
-    std::string plot;
-    if (std::any_of(t.rows.begin(), t.rows.end(), [](const EvalResult& r) { return r.latency.has_value(); })) {
+    std::string plot, networks_plot;
+    const auto timed = [&](bool network) {
+      return std::count_if(t.rows.begin(), t.rows.end(), [&](const EvalResult& r) {
+        return r.latency.has_value() && r.cost.has_value() == network;
+      });
+    };
+    if (timed(true) + timed(false) > 0) {
       plot = "plot_" + stem;
       save_plot(plot, report_plot(t, roles));
       markdown += "![PSNR against latency](" + plot + ".png)\n\n";
+    }
+    // The networks again, closer, when the classic upscalers stretch the axes.
+    if (timed(false) > 0 && timed(true) > 1) {
+      networks_plot = plot + "_networks";
+      save_plot(networks_plot, report_plot(t, roles, true));
+      markdown += "![PSNR against latency, the networks](" + networks_plot + ".png)\n\n";
     }
     std::string frame_plot;
     if (const auto per_frame = psnr_per_frame_plot(t)) {
@@ -268,6 +299,8 @@ nlohmann::ordered_json write_report(const std::vector<EvalResult>& evaluations, 
                                  {"rows", t.rows.size()},
                                  {"plot", plot.empty() ? "" : plot + ".png"},
                                  {"plot_svg", plot.empty() ? "" : plot + ".svg"},
+                                 {"networks_plot", networks_plot.empty() ? "" : networks_plot + ".png"},
+                                 {"networks_plot_svg", networks_plot.empty() ? "" : networks_plot + ".svg"},
                                  {"frame_plot", frame_plot.empty() ? "" : frame_plot + ".png"},
                                  {"frame_plot_svg", frame_plot.empty() ? "" : frame_plot + ".svg"},
                                  {"heldout", heldout}});

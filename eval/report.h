@@ -55,17 +55,26 @@ std::string table_file_stem(const std::vector<ReportTable>& tables, size_t i);
 // Indices of rows on the Pareto front: no other row is both faster and at least as good (PSNR).
 std::vector<size_t> pareto_front(const ReportTable& table);
 
+// Controls of one kind cut to several latencies: drawn as one line in a colour of its own, each
+// point labelled short (the legend names the kind), so a kind's curve reads at a glance.
+struct ReportCurve {
+  std::string name;                                         // legend entry
+  std::vector<std::pair<std::string, std::string>> points;  // (row name, its label on the plot)
+};
+
 // What rows are, for the plot: final networks and controls are drawn apart from the other
 // networks, and each network is joined to its controls. Rows named in neither list are networks,
-// or classic upscalers when they have no parameter count.
+// or classic upscalers when they have no parameter count; a row on a curve is drawn on it.
 struct ReportRoles {
   std::vector<std::string> finals, controls;
   std::vector<std::pair<std::string, std::string>> pairs;  // (network, one of its controls)
+  std::vector<ReportCurve> curves;
 };
 
 // PSNR against latency, each point named; rows without latency are lines across the plot at
-// their PSNR.
-ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles = {});
+// their PSNR. `networks_only` leaves out the rows without a parameter count (classic upscalers),
+// so the axes close in on the networks, which sit close together far from them.
+ScatterPlot report_plot(const ReportTable& table, const ReportRoles& roles = {}, bool networks_only = false);
 
 // Every evaluation found in the given run directories / results files (results.json of
 // `cgsr eval`, `cgsr prune` or `cgsr report`), in order.

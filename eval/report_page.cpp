@@ -176,6 +176,9 @@ void write_report_page(const std::filesystem::path& dir, const nlohmann::ordered
       << table_html(table);
     if (meta && !meta->value("plot_svg", "").empty())
       h << "<img src=\"" << html_escape(meta->value("plot_svg", "")) << "\" alt=\"PSNR against latency\">\n";
+    if (meta && !meta->value("networks_plot_svg", "").empty())
+      h << "<img src=\"" << html_escape(meta->value("networks_plot_svg", ""))
+        << "\" alt=\"PSNR against latency, the networks\">\n";
     if (meta && !meta->value("frame_plot_svg", "").empty())
       h << "<h3>PSNR per frame</h3>\n<img src=\"" << html_escape(meta->value("frame_plot_svg", ""))
         << "\" alt=\"PSNR per frame\">\n<p class=\"note\">" << html_escape(psnr_per_frame_caption()) << "</p>\n";

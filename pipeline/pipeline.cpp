@@ -698,10 +698,23 @@ class Pipeline {
     r.finals = {roles_.input.name, roles_.hybrid.name};
     r.controls = {control_.name};
     r.pairs = {{enhanced, control_.name}};
-    for (const auto& c : control_models()) {
-      r.controls.push_back(c.name);
-      r.pairs.emplace_back(roles_.input.name, c.name);
+    if (options_.scratch.enabled) {
+      r.controls.push_back(scratch_.name);
+      r.pairs.emplace_back(roles_.input.name, scratch_.name);
     }
+    // Each kind's cuts as one curve, labelled by kind and latency factor; the final network is
+    // joined to its equal-latency cut (the curve shows the others).
+    if (controlled_.summary.contains("controls"))
+      for (const auto& c : controlled_.summary.at("controls")) {
+        const auto kind = enum_from_name<ControlKind>(c.at("kind").get<std::string>());
+        const std::string name = c.at("name").get<std::string>(), label = control_label(kind);
+        const double factor = c.at("latency_factor").get<double>();
+        auto curve = std::find_if(r.curves.begin(), r.curves.end(), [&](const auto& x) { return x.name == label + " control"; });
+        if (curve == r.curves.end()) curve = r.curves.insert(r.curves.end(), ReportCurve{label + " control", {}});
+        curve->points.emplace_back(name, fmt::format("{} {:g}x", label, factor));
+        r.controls.push_back(name);
+        if (factor == 1.0) r.pairs.emplace_back(roles_.input.name, name);
+      }
     return r;
   }
 

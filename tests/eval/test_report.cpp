@@ -144,6 +144,57 @@ TEST(Report, PlotMarksRolesAndJoinsPairs) {
   EXPECT_DOUBLE_EQ(plot.links[0].x1, 12.1);
 }
 
+// A control kind cut to several latencies is one line of its own, its points labelled short;
+// the other rows keep their series.
+TEST(Report, PlotDrawsEachCurveAsALine) {
+  ReportTable t{"hall", 2,
+                {row("pan cg", 33.3, 12.5, 270000), row("slim", 33.2, 4.0, 70000), row("mmp", 32.9, 4.1, 90000),
+                 row("mmp at 1.5x", 33.1, 6.0, 120000), row("uniform", 33.0, 4.0, 60000)}, ""};
+  ReportRoles roles;
+  roles.finals = {"slim"};
+  roles.controls = {"mmp", "mmp at 1.5x", "uniform"};
+  roles.curves = {{"MMP control", {{"mmp", "MMP 1x"}, {"mmp at 1.5x", "MMP 1.5x"}, {"not timed", "MMP 2x"}}}};
+  const ScatterPlot plot = report_plot(t, roles);
+  const auto curve = std::find_if(plot.series.begin(), plot.series.end(),
+                                  [](const PlotSeries& s) { return s.name == "MMP control"; });
+  ASSERT_NE(curve, plot.series.end());
+  EXPECT_TRUE(curve->connect);
+  ASSERT_EQ(curve->points.size(), 2u);  // a curve's row missing from the table is left out
+  EXPECT_EQ(curve->points[0].label, "MMP 1x");
+  EXPECT_DOUBLE_EQ(curve->points[0].x, 4.1);
+  EXPECT_EQ(curve->points[1].label, "MMP 1.5x");
+  EXPECT_DOUBLE_EQ(curve->points[1].y, 33.1);
+  for (const auto& s : plot.series)
+    for (const auto& p : s.points) {
+      if (p.label == "uniform") {
+        EXPECT_EQ(s.name, "control");
+      }
+      if (p.label == "slim") {
+        EXPECT_EQ(s.name, "final network");
+      }
+      EXPECT_NE(p.label, "mmp") << s.name;  // drawn on the curve only, under its short label
+    }
+  EXPECT_EQ(plot.series.back().name, "final network");  // drawn last, on top
+}
+
+// With classic upscalers timed beside two networks, the networks get a second plot of their own
+// (no classic row on it), in the results, the Markdown and the page; without them, none.
+TEST(Report, WriteReportZoomsOnTheNetworks) {
+  const auto dir = test::scratch_dir("report-zoom");
+  {
+    RunDir run(dir, /*own_log=*/false);
+    const ReportTable t{"hall", 2, {row("bicubic", 30, 0.5), row("pan", 33, 12.0, 261403), row("slim", 32.9, 4.0, 70000)}, ""};
+    for (const auto& s : report_plot(t, {}, true).series) EXPECT_NE(s.name, "classic upscaler");
+    const auto results = write_report(t.rows, run);
+    EXPECT_EQ(results["tables"][0].at("networks_plot"), "plot_hall_x2_networks.png");
+    const auto networks_only = write_report({row("pan", 33, 12.0, 261403), row("slim", 32.9, 4.0, 70000)}, run);
+    EXPECT_EQ(networks_only["tables"][0].at("networks_plot"), "");
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "plot_hall_x2_networks.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "plot_hall_x2_networks.svg"));
+  std::filesystem::remove_all(dir);
+}
+
 namespace {
 // A row scored on `frames`, PSNR 30 + frame / 100 (+inf on `identical`), in scenes starting at
 // the given (name, first frame).
