@@ -326,9 +326,8 @@ class Writer {
     const std::string transposed = claim(p + ".offsets_nhwc");
     attr(node("Transpose", p + ".transpose", {offsets}, {transposed}), "perm", std::vector<int64_t>{0, 2, 3, 1});
     const std::string grid = make("Add", "grid", {make("Mul", "scaled", {transposed, scale}), base});
-    graph::sample_interpolation(op.mode);  // rejects modes that are not sampling modes
     auto* n = node("GridSample", op.name, {source, grid}, {out});
-    attr(n, "mode", std::string(op.mode == graph::ResizeMode::Nearest ? "nearest" : "bilinear"));
+    attr(n, "mode", std::string(graph::resize_mode_name(op.mode)));  // opset 16: nearest, bilinear, bicubic
     attr(n, "padding_mode", std::string("border"));
     attr(n, "align_corners", int64_t{0});
   }

@@ -64,6 +64,10 @@ const std::vector<std::string>& EnumNames<RitFusion>::names() {
   static const std::vector<std::string> names = {"concat", "add"};
   return names;
 }
+const std::vector<std::string>& EnumNames<WarpFilter>::names() {
+  static const std::vector<std::string> names = {"bilinear", "bicubic"};
+  return names;
+}
 const std::vector<std::string>& EnumNames<ImageSkip>::names() {
   static const std::vector<std::string> names = {"bilinear", "bicubic"};
   return names;
@@ -182,6 +186,9 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
       std::find(rit_channels.begin(), rit_channels.end(), RenderChannel::HistoryOut) != rit_channels.end();
   check_output_option(spec.rit.history_blend, "history_blend", recurrent ? RenderChannel::HistoryOut : RenderChannel::History,
                       "blends the output with");
+  if (spec.rit.history_warp != WarpFilter::Bilinear && !recurrent)
+    problems.push_back({"rit.history_warp", "resamples the previous output, which rit.channels [" +
+                                                join(spec.rit.channels) + "] does not read: add history_out"});
   if (recurrent && spec.rit.enabled && !spec.rit.reads_hr())
     problems.push_back({"rit.source", "history_out warps the previous output at the output resolution, which rit.source "
                                       "lr does not give: use an HR source"});
@@ -281,6 +288,8 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.field("residual_at_jitter", &RitSpec::residual_at_jitter,
             "resample the rest of the output (over the skip) at the jitter too, at the output resolution");
   rit.omit_when("residual_at_jitter", [](const RitSpec& r) { return !r.residual_at_jitter; });
+  rit.field("history_warp", &RitSpec::history_warp, "how history_out's previous output is resampled at its motion");
+  rit.omit_when("history_warp", [](const RitSpec& r) { return r.history_warp == WarpFilter::Bilinear; });
   return rit;
 }
 
@@ -347,7 +356,8 @@ std::string spec_summary(const ArchSpec& spec) {
     if (r.hr_branch()) widths += ", hr w" + std::to_string(r.hr_width);
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
          " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") +
-         (r.skip_at_jitter ? (r.residual_at_jitter ? ", output at jitter" : ", skip at jitter") : "") + "]";
+         (r.skip_at_jitter ? (r.residual_at_jitter ? ", output at jitter" : ", skip at jitter") : "") +
+         (r.history_warp != WarpFilter::Bilinear ? ", " + enum_name(r.history_warp) + " warp" : "") + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

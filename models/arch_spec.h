@@ -32,6 +32,8 @@
 //                            #   (needs jitter among channels, an HR source)
 //     residual_at_jitter: false  # the rest of the output moved to the jitter as well, at HR
 //                            #   (needs skip_at_jitter)
+//     history_warp: bilinear # how history_out's previous output is resampled at its motion:
+//                            #   bilinear, or bicubic (sharper; needs history_out)
 //   geometry:                # training-only head predicting the HR rendering information
 //     enabled: true
 //     width: 16
@@ -87,6 +89,15 @@ struct EnumNames<RitFusion> {
   static const std::vector<std::string>& names();
 };
 
+// How a recurrent network's previous output is resampled when warped to the current frame (rit.h):
+// bilinear, or bicubic (a = -0.75, sharper: a bilinear warp blurs what it carries, every frame).
+enum class WarpFilter { Bilinear, Bicubic };
+template <>
+struct EnumNames<WarpFilter> {
+  static constexpr const char* kind = "history warp";
+  static const std::vector<std::string>& names();
+};
+
 // The colour channels a network works on: rgb, or y (BT.601 luma; SRCNN only).
 enum class Colors { Rgb, Y };
 template <>
@@ -127,6 +138,8 @@ struct RitSpec {
   // backbone reads the jittered frame as if aligned, so its detail sits s * jitter HR pixels off;
   // it is resampled there at HR (rit.h).
   bool residual_at_jitter = false;
+  // history_out's warp of the previous output (rit.h).
+  WarpFilter history_warp = WarpFilter::Bilinear;
 
   std::vector<RenderChannel> render_channels() const { return parse_channels(channels); }
   int info_width() const { return total_width(render_channels()); }
@@ -141,7 +154,7 @@ struct RitSpec {
     return enabled == o.enabled && channels == o.channels && width == o.width && source == o.source &&
            hr_width == o.hr_width && fusion == o.fusion && depth_encoding == o.depth_encoding &&
            bsp_composite == o.bsp_composite && history_blend == o.history_blend && skip_at_jitter == o.skip_at_jitter &&
-           residual_at_jitter == o.residual_at_jitter;
+           residual_at_jitter == o.residual_at_jitter && history_warp == o.history_warp;
   }
 };
 

@@ -308,7 +308,6 @@ int Builder::sample(int source, int offsets, ResizeMode mode) {
              what + ": the offsets must be one fixed 2-channel axis (dx, dy), got " + layout_string(off.layout));
   CGSR_CHECK(off.factor % src.factor == 0, what + ": the offsets' factor " + std::to_string(off.factor) +
                                                " is not a multiple of the source's " + std::to_string(src.factor));
-  CGSR_CHECK(mode != ResizeMode::Bicubic, what + ": sampling is nearest or bilinear");
   Value out = src;
   out.factor = off.factor;
   Op op;
@@ -376,9 +375,9 @@ int64_t sample_interpolation(ResizeMode mode) {
   switch (mode) {
     case ResizeMode::Bilinear: return 0;
     case ResizeMode::Nearest: return 1;
-    case ResizeMode::Bicubic: break;
+    case ResizeMode::Bicubic: return 2;
   }
-  throw Error("sample", std::string("mode ") + resize_mode_name(mode) + " is not a sampling mode (nearest, bilinear)");
+  throw Error("sample", "unknown sampling mode " + std::to_string(static_cast<int>(mode)));
 }
 
 torch::Tensor apply_sample(const torch::Tensor& source, const torch::Tensor& offsets, int64_t ratio, ResizeMode mode) {

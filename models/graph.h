@@ -40,7 +40,8 @@
 //                  zero offsets are nearest/bilinear upsampling by r; r = 1 warps by a motion
 //                  field). `mode` Nearest rounds x and y half to even (nearbyint) and clamps the
 //                  index to the image; Bilinear clamps x and y to [0, size - 1] and interpolates
-//                  (border padding). Computed as grid_sampler(source, grid, align_corners=False,
+//                  (border padding); Bicubic (a = -0.75) reads the 4x4 pixels around x, y, each
+//                  index clamped to the image. Computed as grid_sampler(source, grid, align_corners=False,
 //                  padding border) with the normalized grid of sample_grid() below, which the
 //                  exporters write with the same float operations (ONNX GridSample, opset 16).
 //   AnyAbsAbove    [x] -> 1 channel (fixed "mask"): 1 where max over channels |x[c]| > threshold,
@@ -237,7 +238,7 @@ torch::Tensor apply_any_abs_above(const torch::Tensor& x, double threshold);
 //   sample_grid_scale: [2], 2 / source_w and 2 / source_h in float32 (source pixels to normalized units)
 torch::Tensor sample_grid_base(int64_t out_h, int64_t out_w, int64_t ratio, int64_t source_h, int64_t source_w);
 torch::Tensor sample_grid_scale(int64_t source_h, int64_t source_w);
-// grid_sampler's interpolation_mode of a Sample mode (0 bilinear, 1 nearest); Error for bicubic.
+// grid_sampler's interpolation_mode of a Sample mode (0 bilinear, 1 nearest, 2 bicubic).
 int64_t sample_interpolation(ResizeMode mode);
 
 // Called after each op with its index in graph.ops and its output; returns the value the later

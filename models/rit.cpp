@@ -89,6 +89,7 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
     for (int64_t k : {0, 1, 2, 4, 5}) previous_keep_[offset + k][offset + k] = 0.0f;
     previous_embed_ = torch::zeros({c, 3, 1, 1});
     for (int64_t k = 0; k < 3; ++k) previous_embed_[offset + k][k] = 1.0f;
+    previous_warp_ = rit.history_warp == WarpFilter::Bicubic ? graph::ResizeMode::Bicubic : graph::ResizeMode::Bilinear;
   }
   if (rit.history_blend) {
     CGSR_CHECK(info_factor_ == scale, "RIT: history_blend needs the information at the output resolution");
@@ -119,8 +120,8 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
 torch::Tensor RitBlockImpl::warp_previous_output(const torch::Tensor& info) const {
   if (!reads_previous_output()) return info;
   // The kernels and the operand order of describe_warp_previous_output(), so both give the same bits.
-  const auto warped = graph::apply_sample(torch::conv2d(info, previous_color_), torch::conv2d(info, previous_motion_), 1,
-                                          graph::ResizeMode::Bilinear);
+  const auto warped =
+      graph::apply_sample(torch::conv2d(info, previous_color_), torch::conv2d(info, previous_motion_), 1, previous_warp_);
   return torch::conv2d(info, previous_keep_) + torch::conv2d(warped * torch::conv2d(info, previous_validity_), previous_embed_);
 }
 
@@ -131,7 +132,7 @@ int RitBlockImpl::describe_warp_previous_output(graph::Builder& g, int info) con
   const int color = g.conv("previous_color", info, previous_color_, {}, 0, rgb, /*trainable=*/false);
   const int motion = g.conv("previous_motion", info, previous_motion_, {}, 0, graph::fixed_layout("motion", 2),
                             /*trainable=*/false);
-  const int warped = g.sample(color, motion, graph::ResizeMode::Bilinear);
+  const int warped = g.sample(color, motion, previous_warp_);
   const int validity = g.conv("previous_validity", info, previous_validity_, {}, 0, rgb, /*trainable=*/false);
   const int kept = g.conv("previous_keep", info, previous_keep_, {}, 0, layout, /*trainable=*/false);
   return g.add(kept, g.conv("previous_embed", g.mul(warped, validity), previous_embed_, {}, 0, layout,

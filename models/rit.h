@@ -34,7 +34,8 @@
 // 1 the result is exactly bsp_rgb or net (0 * x + y == y), not net + (bsp - net) rounded.
 //
 // history_out: the network's own previous output, passed back in by the runner, is warped to this
-// frame first (graph Sample at the channel's motion, bilinear, border padding) and zeroed where the
+// frame first (graph Sample at the channel's motion, bilinear or, with rit.history_warp bicubic,
+// bicubic; border padding) and zeroed where the
 // channel's validity is 0; every part below reads that instead of the raw channel. Written with
 // fixed 0/1 1x1 convs, Sample, Mul and Add: the exported file warps it too, and the state it takes
 // is the previous output as the network returned it (docs/temporal.md).
@@ -149,6 +150,7 @@ class RitBlockImpl : public torch::nn::Module {
   // (broadcast), [2, C, 1, 1] of its motion; [C, C, 1, 1] the identity but for the colour and the
   // motion, and [C, 3, 1, 1] the warped colour back into the colour's place.
   torch::Tensor previous_color_, previous_validity_, previous_motion_, previous_keep_, previous_embed_;
+  graph::ResizeMode previous_warp_ = graph::ResizeMode::Bilinear;  // rit.history_warp
   int64_t scale_;
 };
 TORCH_MODULE(RitBlock);

@@ -157,7 +157,7 @@ TEST(OnnxNumerics, SampleRoundsHalvesToEvenAndClampsAsOurKernelDoes) {
   const int up = g.resize(color, r, graph::ResizeMode::Nearest);
   const auto pick_rg = torch::tensor({1.f, 0.f, 0.f, 0.f, 1.f, 0.f}).view({2, 3, 1, 1});
   const int offsets = g.conv("offsets", up, pick_rg, torch::Tensor(), 0, graph::fixed_layout("offsets", 2), false);
-  for (const auto mode : {graph::ResizeMode::Nearest, graph::ResizeMode::Bilinear}) {
+  for (const auto mode : {graph::ResizeMode::Nearest, graph::ResizeMode::Bilinear, graph::ResizeMode::Bicubic}) {
     SCOPED_TRACE(graph::resize_mode_name(mode));
     graph::Builder copy = g;
     copy.output("image", copy.sample(color, offsets, mode));

@@ -218,3 +218,25 @@ TEST(ArchSpec, CompositesNeedTheirChannelAtHr) {
   EXPECT_NE(alone.find("rit.residual_at_jitter"), std::string::npos) << alone;
   EXPECT_NE(alone.find("set skip_at_jitter"), std::string::npos) << alone;
 }
+
+// rit.history_warp resamples history_out's previous output: without that channel it is an error
+// naming the key; written only when not bilinear; a misspelt filter names the choices.
+TEST(ArchSpec, HistoryWarpNeedsThePreviousOutput) {
+  const std::string unread =
+      parse_error("backbone: pan\nrit: {enabled: true, channels: [edge], source: hr_fuse, history_warp: bicubic}\n");
+  EXPECT_NE(unread.find("rit.history_warp"), std::string::npos) << unread;
+  EXPECT_NE(unread.find("add history_out"), std::string::npos) << unread;
+  const std::string misspelt =
+      parse_error("backbone: pan\nrit: {enabled: true, channels: [history_out], source: hr_fuse, history_warp: cubic}\n");
+  EXPECT_NE(misspelt.find("bilinear, bicubic"), std::string::npos) << misspelt;
+  ArchSpec s = default_spec("pan", 2);
+  s.rit.enabled = true;
+  s.rit.channels = {"history_out"};
+  s.rit.source = RitSource::HrFuse;
+  EXPECT_EQ(spec_to_yaml(s).find("history_warp"), std::string::npos);
+  s.rit.history_warp = WarpFilter::Bicubic;
+  const std::string yaml = spec_to_yaml(s);
+  EXPECT_NE(yaml.find("history_warp: bicubic"), std::string::npos) << yaml;
+  EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
+  EXPECT_NE(spec_summary(s).find("bicubic warp"), std::string::npos) << spec_summary(s);
+}

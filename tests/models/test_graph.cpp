@@ -2,6 +2,8 @@
 // every backbone with and without the RIT, and the builder rejects inconsistent layouts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -123,7 +125,60 @@ torch::Tensor torch_grid_sample(const torch::Tensor& source, const torch::Tensor
   return torch::grid_sampler(source, grid, nearest ? 1 : 0, /*border*/ 1, /*align_corners=*/false);
 }
 
+// Bicubic (a = -0.75) written out in double: the 4x4 pixels around the unclamped position, each
+// index clamped to the image.
+torch::Tensor reference_bicubic(const torch::Tensor& source, const torch::Tensor& offsets, int64_t r) {
+  const auto s = source.to(torch::kDouble).contiguous();
+  const auto o = offsets.to(torch::kDouble).contiguous();
+  const int64_t n = s.size(0), c = s.size(1), h = s.size(2), w = s.size(3), oh = o.size(2), ow = o.size(3);
+  auto out = torch::zeros({n, c, oh, ow}, torch::kDouble);
+  const auto sa = s.accessor<double, 4>();
+  const auto oa = o.accessor<double, 4>();
+  auto ya = out.accessor<double, 4>();
+  const auto weights = [](double t) {
+    const double a = -0.75;
+    const auto near = [&](double d) { return ((a + 2) * d - (a + 3)) * d * d + 1; };
+    const auto far = [&](double d) { return ((a * d - 5 * a) * d + 8 * a) * d - 4 * a; };
+    return std::array<double, 4>{far(t + 1), near(t), near(1 - t), far(2 - t)};
+  };
+  for (int64_t b = 0; b < n; ++b)
+    for (int64_t i = 0; i < oh; ++i)
+      for (int64_t j = 0; j < ow; ++j) {
+        const double x = (j + 0.5) / r - 0.5 + oa[b][0][i][j], y = (i + 0.5) / r - 0.5 + oa[b][1][i][j];
+        const double x0 = std::floor(x), y0 = std::floor(y);
+        const auto wx = weights(x - x0), wy = weights(y - y0);
+        for (int64_t ch = 0; ch < c; ++ch) {
+          double sum = 0;
+          for (int64_t u = 0; u < 4; ++u)
+            for (int64_t v = 0; v < 4; ++v) {
+              const auto yi = std::clamp<int64_t>(static_cast<int64_t>(y0) - 1 + u, 0, h - 1);
+              const auto xi = std::clamp<int64_t>(static_cast<int64_t>(x0) - 1 + v, 0, w - 1);
+              sum += wy[u] * wx[v] * sa[b][ch][yi][xi];
+            }
+          ya[b][ch][i][j] = sum;
+        }
+      }
+  return out.to(torch::kFloat);
+}
+
 }  // namespace
+
+// Bicubic reads 4x4 pixels, each index clamped: at whole-pixel offsets the pixel itself, between
+// them an overshooting interpolation (a = -0.75), far outside a border pixel.
+TEST(SampleOp, BicubicMatchesTheDefinition) {
+  torch::manual_seed(43);
+  for (int64_t r : {1, 2}) {
+    SCOPED_TRACE("ratio " + std::to_string(r));
+    const auto source = torch::rand({2, 3, 6, 7});
+    auto offsets = torch::randn({2, 2, 6 * r, 7 * r}) * 2;
+    offsets.slice(2, 0, 2) *= 40;
+    const auto got = graph::apply_sample(source, offsets, r, graph::ResizeMode::Bicubic);
+    EXPECT_TRUE(torch::allclose(got, reference_bicubic(source, offsets, r), 1e-5, 1e-5));
+  }
+  const auto source = torch::rand({1, 1, 6, 7});
+  const auto shifted = graph::apply_sample(source, torch::ones({1, 2, 6, 7}), 1, graph::ResizeMode::Bicubic);
+  EXPECT_TRUE(torch::allclose(shifted.slice(2, 0, 5).slice(3, 0, 6), source.slice(2, 1, 6).slice(3, 1, 7), 1e-6, 1e-6));
+}
 
 TEST(SampleOp, MatchesGridSamplerAndTheDefinitionOnRandomAndFarOutsideOffsets) {
   torch::manual_seed(41);
@@ -184,7 +239,7 @@ TEST(SampleOp, BuilderChecksTheOffsetsAndTheFactors) {
   EXPECT_THROW(g.sample(hr, color, graph::ResizeMode::Nearest), Error);  // 3 channels, factor 1 < 2
   const int odd = g.input("odd", graph::fixed_layout("offsets", 2), 3);
   EXPECT_THROW(g.sample(hr, odd, graph::ResizeMode::Nearest), Error);  // 3 is no multiple of 2
-  EXPECT_THROW(g.sample(color, hr, graph::ResizeMode::Bicubic), Error);
+  EXPECT_EQ(g.value(g.sample(color, hr, graph::ResizeMode::Bicubic)).factor, 2);
   const int prunable = g.input("p", graph::group_layout("features", 2), 2);
   EXPECT_THROW(g.sample(color, prunable, graph::ResizeMode::Nearest), Error);
   EXPECT_THROW(graph::apply_sample(torch::rand({1, 3, 4, 4}), torch::zeros({1, 2, 8, 7}), 2,

@@ -456,6 +456,41 @@ TEST(Rit, AugmentedJitterSamplesTheAugmentedFrame) {
   }
 }
 
+// rit.history_warp bicubic: the previous output read at whole-pixel motion is the pixel itself, as
+// with bilinear; at half a pixel the two filters differ, and the network's warp is the graph op's
+// bicubic sample; graph, forward() and the fused path agree.
+TEST(Rit, HistoryWarpBicubicResamplesThePreviousOutput) {
+  torch::manual_seed(43);
+  const auto c = all_backbone_cases().front();
+  auto spec = with_rit(spec_for(c), "hr_fuse");
+  spec.rit.channels = {"edge", "history_out"};
+  spec.rit.history_blend = true;
+  auto bicubic_spec = spec;
+  bicubic_spec.rit.history_warp = WarpFilter::Bicubic;
+  SRNetwork bilinear(resolve_spec(spec)), bicubic(resolve_spec(bicubic_spec));
+  torch::NoGradGuard no_grad;
+  auto theirs = bilinear->named_parameters();
+  for (auto& p : bicubic->named_parameters()) p.value().copy_(theirs[p.key()]);
+  for (SRNetwork* net : {&bilinear, &bicubic}) (*net)->rit()->blend->bias.fill_(30.0f);  // the output is the warp
+  auto [color, info] = random_inputs(bicubic->spec(), 7, 5);
+  info.select(1, 4).fill_(1.0f);  // valid everywhere
+  info.select(1, 5).fill_(1.0f);
+  info.select(1, 6).zero_();
+  const auto whole = bicubic->forward(color, info);
+  EXPECT_TRUE(torch::allclose(whole, bilinear->forward(color, info), 1e-5, 1e-5));
+  EXPECT_TRUE(torch::allclose(whole, moved_by(info.slice(1, 1, 4), 0, 1), 1e-5, 1e-5));
+  info.select(1, 5).fill_(0.5f);
+  const auto half = bicubic->forward(color, info);
+  EXPECT_GT((half - bilinear->forward(color, info)).abs().max().item<float>(), 1e-3);
+  const auto expected = graph::apply_sample(info.slice(1, 1, 4), info.slice(1, 5, 7), 1, graph::ResizeMode::Bicubic);
+  EXPECT_TRUE(torch::allclose(half, expected, 1e-5, 1e-5));
+  const auto deployed = bicubic->describe(/*training=*/false);
+  const auto served = graph::run(deployed, network_inputs(deployed, color, info)).front().second;
+  EXPECT_TRUE(torch::equal(served, half));
+  FusedGraph fused(deployed);
+  EXPECT_TRUE(torch::allclose(fused.run(color, info), served, 1e-4, 1e-4));
+}
+
 // history_out (the network's own previous output, planes 1-3 here, its validity 4, its motion 5-6)
 // over every backbone, scale and HR source: where no pixel is valid the previous colour changes
 // nothing, bit for bit; where some are it does; a blend weight driven high gives the previous
