@@ -708,9 +708,10 @@ class Pipeline {
       for (const auto& c : controlled_.summary.at("controls")) {
         const auto kind = enum_from_name<ControlKind>(c.at("kind").get<std::string>());
         const std::string name = c.at("name").get<std::string>(), label = control_label(kind);
+        const std::string curve_name = label + " control";
         const double factor = c.at("latency_factor").get<double>();
-        auto curve = std::find_if(r.curves.begin(), r.curves.end(), [&](const auto& x) { return x.name == label + " control"; });
-        if (curve == r.curves.end()) curve = r.curves.insert(r.curves.end(), ReportCurve{label + " control", {}});
+        auto curve = std::find_if(r.curves.begin(), r.curves.end(), [&](const auto& x) { return x.name == curve_name; });
+        if (curve == r.curves.end()) curve = r.curves.insert(r.curves.end(), ReportCurve{curve_name, {}});
         curve->points.emplace_back(name, fmt::format("{} {:g}x", label, factor));
         r.controls.push_back(name);
         if (factor == 1.0) r.pairs.emplace_back(roles_.input.name, name);
