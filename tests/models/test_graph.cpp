@@ -82,8 +82,10 @@ namespace {
 
 // The Sample op written out independently, in double: output pixel (i, j) reads the source at
 // x = (j + 0.5) / r - 0.5 + dx, y likewise; nearest rounds half to even and clamps the index,
-// bilinear clamps the position to [0, size - 1] and interpolates.
-torch::Tensor reference_sample(const torch::Tensor& source, const torch::Tensor& offsets, int64_t r, bool nearest) {
+// bilinear clamps the position to [0, size - 1] and interpolates, bicubic (a = -0.75) weighs the
+// 4x4 pixels around the unclamped position, each index clamped.
+torch::Tensor reference_sample(const torch::Tensor& source, const torch::Tensor& offsets, int64_t r,
+                               graph::ResizeMode mode) {
   const auto s = source.to(torch::kDouble).contiguous();
   const auto o = offsets.to(torch::kDouble).contiguous();
   const int64_t n = s.size(0), c = s.size(1), h = s.size(2), w = s.size(3), oh = o.size(2), ow = o.size(3);
@@ -91,23 +93,37 @@ torch::Tensor reference_sample(const torch::Tensor& source, const torch::Tensor&
   const auto sa = s.accessor<double, 4>();
   const auto oa = o.accessor<double, 4>();
   auto ya = out.accessor<double, 4>();
+  const auto cubic = [](double t) {
+    const double a = -0.75;
+    const auto near = [&](double d) { return ((a + 2) * d - (a + 3)) * d * d + 1; };
+    const auto far = [&](double d) { return ((a * d - 5 * a) * d + 8 * a) * d - 4 * a; };
+    return std::array<double, 4>{far(t + 1), near(t), near(1 - t), far(2 - t)};
+  };
+  const auto at = [&](int64_t b, int64_t ch, int64_t yi, int64_t xi) {
+    return sa[b][ch][std::clamp<int64_t>(yi, 0, h - 1)][std::clamp<int64_t>(xi, 0, w - 1)];
+  };
   for (int64_t b = 0; b < n; ++b)
     for (int64_t i = 0; i < oh; ++i)
       for (int64_t j = 0; j < ow; ++j) {
-        double x = (j + 0.5) / r - 0.5 + oa[b][0][i][j], y = (i + 0.5) / r - 0.5 + oa[b][1][i][j];
+        const double x = (j + 0.5) / r - 0.5 + oa[b][0][i][j], y = (i + 0.5) / r - 0.5 + oa[b][1][i][j];
         for (int64_t ch = 0; ch < c; ++ch) {
-          if (nearest) {
-            const auto xi = std::clamp<int64_t>(static_cast<int64_t>(std::nearbyint(x)), 0, w - 1);
-            const auto yi = std::clamp<int64_t>(static_cast<int64_t>(std::nearbyint(y)), 0, h - 1);
-            ya[b][ch][i][j] = sa[b][ch][yi][xi];
-            continue;
+          if (mode == graph::ResizeMode::Nearest) {
+            ya[b][ch][i][j] = at(b, ch, static_cast<int64_t>(std::nearbyint(y)), static_cast<int64_t>(std::nearbyint(x)));
+          } else if (mode == graph::ResizeMode::Bilinear) {
+            const double cx = std::clamp(x, 0.0, static_cast<double>(w - 1)), cy = std::clamp(y, 0.0, static_cast<double>(h - 1));
+            const auto x0 = static_cast<int64_t>(std::floor(cx)), y0 = static_cast<int64_t>(std::floor(cy));
+            const double fx = cx - x0, fy = cy - y0;
+            ya[b][ch][i][j] = (1 - fy) * ((1 - fx) * at(b, ch, y0, x0) + fx * at(b, ch, y0, x0 + 1)) +
+                              fy * ((1 - fx) * at(b, ch, y0 + 1, x0) + fx * at(b, ch, y0 + 1, x0 + 1));
+          } else {
+            const double x0 = std::floor(x), y0 = std::floor(y);
+            const auto wx = cubic(x - x0), wy = cubic(y - y0);
+            double sum = 0;
+            for (int64_t u = 0; u < 4; ++u)
+              for (int64_t v = 0; v < 4; ++v)
+                sum += wy[u] * wx[v] * at(b, ch, static_cast<int64_t>(y0) - 1 + u, static_cast<int64_t>(x0) - 1 + v);
+            ya[b][ch][i][j] = sum;
           }
-          const double cx = std::clamp(x, 0.0, static_cast<double>(w - 1)), cy = std::clamp(y, 0.0, static_cast<double>(h - 1));
-          const auto x0 = static_cast<int64_t>(std::floor(cx)), y0 = static_cast<int64_t>(std::floor(cy));
-          const int64_t x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-          const double fx = cx - x0, fy = cy - y0;
-          ya[b][ch][i][j] = (1 - fy) * ((1 - fx) * sa[b][ch][y0][x0] + fx * sa[b][ch][y0][x1]) +
-                            fy * ((1 - fx) * sa[b][ch][y1][x0] + fx * sa[b][ch][y1][x1]);
         }
       }
   return out.to(torch::kFloat);
@@ -125,42 +141,6 @@ torch::Tensor torch_grid_sample(const torch::Tensor& source, const torch::Tensor
   return torch::grid_sampler(source, grid, nearest ? 1 : 0, /*border*/ 1, /*align_corners=*/false);
 }
 
-// Bicubic (a = -0.75) written out in double: the 4x4 pixels around the unclamped position, each
-// index clamped to the image.
-torch::Tensor reference_bicubic(const torch::Tensor& source, const torch::Tensor& offsets, int64_t r) {
-  const auto s = source.to(torch::kDouble).contiguous();
-  const auto o = offsets.to(torch::kDouble).contiguous();
-  const int64_t n = s.size(0), c = s.size(1), h = s.size(2), w = s.size(3), oh = o.size(2), ow = o.size(3);
-  auto out = torch::zeros({n, c, oh, ow}, torch::kDouble);
-  const auto sa = s.accessor<double, 4>();
-  const auto oa = o.accessor<double, 4>();
-  auto ya = out.accessor<double, 4>();
-  const auto weights = [](double t) {
-    const double a = -0.75;
-    const auto near = [&](double d) { return ((a + 2) * d - (a + 3)) * d * d + 1; };
-    const auto far = [&](double d) { return ((a * d - 5 * a) * d + 8 * a) * d - 4 * a; };
-    return std::array<double, 4>{far(t + 1), near(t), near(1 - t), far(2 - t)};
-  };
-  for (int64_t b = 0; b < n; ++b)
-    for (int64_t i = 0; i < oh; ++i)
-      for (int64_t j = 0; j < ow; ++j) {
-        const double x = (j + 0.5) / r - 0.5 + oa[b][0][i][j], y = (i + 0.5) / r - 0.5 + oa[b][1][i][j];
-        const double x0 = std::floor(x), y0 = std::floor(y);
-        const auto wx = weights(x - x0), wy = weights(y - y0);
-        for (int64_t ch = 0; ch < c; ++ch) {
-          double sum = 0;
-          for (int64_t u = 0; u < 4; ++u)
-            for (int64_t v = 0; v < 4; ++v) {
-              const auto yi = std::clamp<int64_t>(static_cast<int64_t>(y0) - 1 + u, 0, h - 1);
-              const auto xi = std::clamp<int64_t>(static_cast<int64_t>(x0) - 1 + v, 0, w - 1);
-              sum += wy[u] * wx[v] * sa[b][ch][yi][xi];
-            }
-          ya[b][ch][i][j] = sum;
-        }
-      }
-  return out.to(torch::kFloat);
-}
-
 }  // namespace
 
 // Bicubic reads 4x4 pixels, each index clamped: at whole-pixel offsets the pixel itself, between
@@ -173,7 +153,7 @@ TEST(SampleOp, BicubicMatchesTheDefinition) {
     auto offsets = torch::randn({2, 2, 6 * r, 7 * r}) * 2;
     offsets.slice(2, 0, 2) *= 40;
     const auto got = graph::apply_sample(source, offsets, r, graph::ResizeMode::Bicubic);
-    EXPECT_TRUE(torch::allclose(got, reference_bicubic(source, offsets, r), 1e-5, 1e-5));
+    EXPECT_TRUE(torch::allclose(got, reference_sample(source, offsets, r, graph::ResizeMode::Bicubic), 1e-5, 1e-5));
   }
   const auto source = torch::rand({1, 1, 6, 7});
   const auto shifted = graph::apply_sample(source, torch::ones({1, 2, 6, 7}), 1, graph::ResizeMode::Bicubic);
@@ -190,9 +170,9 @@ TEST(SampleOp, MatchesGridSamplerAndTheDefinitionOnRandomAndFarOutsideOffsets) {
     const auto nearest = graph::apply_sample(source, offsets, r, graph::ResizeMode::Nearest);
     const auto bilinear = graph::apply_sample(source, offsets, r, graph::ResizeMode::Bilinear);
     EXPECT_EQ(nearest.sizes().vec(), (std::vector<int64_t>{2, 3, 5 * r, 7 * r}));
-    EXPECT_TRUE(torch::equal(nearest, reference_sample(source, offsets, r, true)));
+    EXPECT_TRUE(torch::equal(nearest, reference_sample(source, offsets, r, graph::ResizeMode::Nearest)));
     EXPECT_TRUE(torch::equal(nearest, torch_grid_sample(source, offsets, r, true)));
-    EXPECT_TRUE(torch::allclose(bilinear, reference_sample(source, offsets, r, false), 1e-5, 1e-5));
+    EXPECT_TRUE(torch::allclose(bilinear, reference_sample(source, offsets, r, graph::ResizeMode::Bilinear), 1e-5, 1e-5));
     EXPECT_TRUE(torch::allclose(bilinear, torch_grid_sample(source, offsets, r, false), 1e-5, 1e-5));
     // Clamped, not zero-padded: every far-outside sample is a border pixel.
     EXPECT_GT(nearest.slice(2, 0, 2).abs().min().item<float>(), 0.f);
@@ -207,7 +187,7 @@ TEST(SampleOp, NearestRoundsExactHalvesToEven) {
   auto offsets = torch::zeros({1, 2, h * r, w * r});
   for (int64_t j = 0; j < w * r; ++j) offsets[0][0].select(1, j).fill_(static_cast<double>(j / 2) + 0.75 - j / 2.0);
   const auto got = graph::apply_sample(source, offsets, r, graph::ResizeMode::Nearest);
-  EXPECT_TRUE(torch::equal(got, reference_sample(source, offsets, r, true)));
+  EXPECT_TRUE(torch::equal(got, reference_sample(source, offsets, r, graph::ResizeMode::Nearest)));
   EXPECT_TRUE(torch::equal(got, torch_grid_sample(source, offsets, r, true)));
   for (int64_t j = 0; j < w * r; ++j) {
     const int64_t m = j / 2;                              // position m + 0.5
