@@ -187,6 +187,9 @@ TEST(Report, WriteReportZoomsOnTheNetworks) {
     for (const auto& s : report_plot(t, {}, true).series) EXPECT_NE(s.name, "classic upscaler");
     const auto results = write_report(t.rows, run);
     EXPECT_EQ(results["tables"][0].at("networks_plot"), "plot_hall_x2_networks.png");
+    const std::string md = read_file(dir / "report.md"), page = read_file(dir / "index.html");
+    EXPECT_NE(md.find("(plot_hall_x2_networks.png)"), std::string::npos) << md;
+    EXPECT_NE(page.find("<img src=\"plot_hall_x2_networks.svg\""), std::string::npos) << page;
     const auto networks_only = write_report({row("pan", 33, 12.0, 261403), row("slim", 32.9, 4.0, 70000)}, run);
     EXPECT_EQ(networks_only["tables"][0].at("networks_plot"), "");
   }
