@@ -103,27 +103,35 @@ std::string precision_key(const std::string& shape_key, Precision precision, boo
   return low ? shape_key + "_" + enum_name(precision) : shape_key;
 }
 
-// Solves the least-squares fit of y = a x0 + b x1 + c; false when degenerate.
-bool fit_linear(const std::vector<std::array<double, 3>>& x, const std::vector<double>& y, std::array<double, 3>& out) {
+// The least-squares fit of y on the columns of x that `active` marks (the others' coefficients
+// 0); false when degenerate.
+bool fit_linear(const std::vector<LatencySample>& samples, const std::array<bool, 3>& active,
+                std::array<double, 3>& out) {
+  const auto column = [](const LatencySample& s, int c) { return c == 0 ? s.conv_ms : c == 1 ? s.elements * 1e-6 : 1.0; };
+  std::vector<int> cols;
+  for (int c = 0; c < 3; ++c)
+    if (active[c]) cols.push_back(c);
+  const int n = static_cast<int>(cols.size());
   double m[3][4] = {};
-  for (size_t i = 0; i < x.size(); ++i)
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) m[r][c] += x[i][r] * x[i][c];
-      m[r][3] += x[i][r] * y[i];
+  for (const auto& s : samples)
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) m[r][c] += column(s, cols[r]) * column(s, cols[c]);
+      m[r][3] += column(s, cols[r]) * s.measured_ms;
     }
-  for (int col = 0; col < 3; ++col) {
+  for (int col = 0; col < n; ++col) {
     int pivot = col;
-    for (int r = col + 1; r < 3; ++r)
+    for (int r = col + 1; r < n; ++r)
       if (std::abs(m[r][col]) > std::abs(m[pivot][col])) pivot = r;
     if (std::abs(m[pivot][col]) < 1e-12) return false;
     for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[pivot][c]);
-    for (int r = 0; r < 3; ++r) {
+    for (int r = 0; r < n; ++r) {
       if (r == col) continue;
       const double f = m[r][col] / m[col][col];
       for (int c = 0; c < 4; ++c) m[r][c] -= f * m[col][c];
     }
   }
-  for (int r = 0; r < 3; ++r) out[r] = m[r][3] / m[r][r];
+  out = {0, 0, 0};
+  for (int r = 0; r < n; ++r) out[cols[r]] = m[r][3] / m[r][r];
   return std::all_of(out.begin(), out.end(), [](double v) { return std::isfinite(v); });
 }
 
@@ -148,6 +156,33 @@ std::pair<double, double> LatencyTable::features(const graph::Graph& graph) cons
     }
   }
   return {conv, elements};
+}
+
+void fit_calibration(LatencyTable& table, const std::vector<LatencySample>& samples) {
+  // Non-negative least squares by trying every set of free coefficients (the conv sum's always
+  // among them): an unconstrained fit to a few noisy timings can weigh elements negatively and
+  // predict a small subnet slower than a large one, or below zero.
+  double best_error = INFINITY;
+  for (const std::array<bool, 3> active : {std::array<bool, 3>{true, true, true}, {true, true, false},
+                                           {true, false, true}, {true, false, false}}) {
+    std::array<double, 3> coef{};
+    if (!fit_linear(samples, active, coef) || !(coef[0] > 0) || coef[1] < 0 || coef[2] < 0) continue;
+    double error = 0;
+    for (const auto& s : samples) {
+      const double r = coef[0] * s.conv_ms + coef[1] * 1e-6 * s.elements + coef[2] - s.measured_ms;
+      error += r * r;
+    }
+    if (error >= best_error) continue;
+    best_error = error;
+    table.scale = coef[0];
+    table.element_ns = coef[1];
+    table.offset_ms = coef[2];
+  }
+  if (std::isfinite(best_error)) return;
+  // No timing or no convolution to fit: the sum as it is.
+  table.scale = 1;
+  table.element_ns = 0;
+  table.offset_ms = 0;
 }
 
 double LatencyTable::predict(const graph::Graph& graph) const {
@@ -207,26 +242,14 @@ LatencyTable measure_latency_table(const SRNetworkImpl& net, const ElasticSpace&
   std::vector<SubnetConfig> check_set;
   for (int i = 0; i < options.check_subnets; ++i) check_set.push_back(space.sample(rng));
   Progress progress("latency calibration", static_cast<int64_t>(fit_set.size() + check_set.size()));
-  std::vector<std::array<double, 3>> x;
-  std::vector<double> y;
+  std::vector<LatencySample> samples;
   for (const auto& sub : fit_set) {
     const graph::Graph g = subnet_graph(net, sub);
     const auto [conv, elements] = table.features(g);
-    x.push_back({conv, elements * 1e-6, 1.0});
-    y.push_back(measure_graph_latency(g, lr_width, lr_height, options.subnet_runs, precision));
+    samples.push_back({conv, elements, measure_graph_latency(g, lr_width, lr_height, options.subnet_runs, precision)});
     progress.advance();
   }
-  std::array<double, 3> coef{};
-  if (fit_linear(x, y, coef) && coef[0] > 0) {
-    table.scale = coef[0];
-    table.element_ns = coef[1];
-    table.offset_ms = coef[2];
-  } else {
-    // Too few distinct points: the sum as it is, shifted to the mean measured latency.
-    double residual = 0;
-    for (size_t i = 0; i < x.size(); ++i) residual += y[i] - x[i][0];
-    table.offset_ms = residual / static_cast<double>(x.size());
-  }
+  fit_calibration(table, samples);
   for (const auto& sub : check_set) {
     const graph::Graph g = subnet_graph(net, sub);
     table.error.predicted_ms.push_back(table.predict(g));

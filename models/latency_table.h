@@ -6,9 +6,9 @@
 // channels, stride, spatial factor), timed once on the fused path (fused_graph.h) at the table's
 // LR size; the other ops (element-wise ops, resizes, pixel shuffles), most of which the fused
 // path folds into convolutions, are charged per output element. A linear calibration against
-// whole subnets measured on the fused path, latency = a * sum(conv) + b * elements + c, absorbs
-// what the sum misses: fusions, memory traffic between layers, the fixed cost of a run. Its error
-// on subnets it was not fitted on is recorded with the table.
+// whole subnets measured on the fused path, latency = a * sum(conv) + b * elements + c with no
+// coefficient negative, absorbs what the sum misses: fusions, memory traffic between layers, the
+// fixed cost of a run. Its error on subnets it was not fitted on is recorded with the table.
 //
 // A table is measured for one precision (precision.h). In bf16 or int8 the convolutions that
 // compute in it are timed so, and their keys end in the format ("..._f1_int8"); the wide ones
@@ -62,6 +62,15 @@ struct LatencyTable {
   std::pair<double, double> features(const graph::Graph& graph) const;
   double predict(const graph::Graph& graph) const;
 };
+
+// One whole subnet's calibration point: its features and its measured latency.
+struct LatencySample {
+  double conv_ms = 0, elements = 0, measured_ms = 0;
+};
+
+// Sets the table's calibration to the least-squares fit of the samples with every coefficient
+// non-negative (the scale positive), so predictions never fall below zero or as a subnet grows.
+void fit_calibration(LatencyTable& table, const std::vector<LatencySample>& samples);
 
 // "k3_i20_o40_s1_p1_g1_f1": a convolution's shape key (without a precision).
 std::string conv_shape_key(const graph::Graph& graph, const graph::Op& op);
