@@ -8,28 +8,22 @@
 #include "core/error.h"
 
 namespace cgsr {
-namespace {
-const TextStyle kTitle{16, true}, kAxis{13}, kTick{11, false, {70, 70, 70}}, kLabel{11}, kLegend{12};
-constexpr double kLabelGap = 4;  // pixels between a point label and any other text or marker
-const Rgb kBlack{0, 0, 0}, kGrid{225, 225, 225}, kFrame{60, 60, 60}, kLeader{150, 150, 150}, kLink{70, 70, 70};
 
-std::string tick_text(double v) {
-  std::ostringstream s;
-  s.precision(v != 0 && std::abs(v) < 1 ? 2 : 4);
-  s << v;
-  return s.str();
-}
-
-// "Nice" tick values covering [lo, hi] (for a log axis, lo and hi are log10 values).
-std::vector<double> ticks(double lo, double hi, bool log_scale) {
+std::vector<double> axis_ticks(double lo, double hi, bool log_scale) {
   std::vector<double> out;
   if (log_scale) {
-    for (int e = static_cast<int>(std::floor(lo)); e <= static_cast<int>(std::ceil(hi)); ++e)
-      for (int m : {1, 2, 5}) {
-        const double v = m * std::pow(10.0, e);
-        if (std::log10(v) >= lo && std::log10(v) <= hi) out.push_back(v);
-      }
-    return out;
+    // A latency axis often spans less than a decade (the networks of a report: 110-420 ms), where
+    // 1-2-5 leaves a single tick.
+    for (const std::vector<int>& mantissas : {std::vector<int>{1, 2, 5}, std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}}) {
+      out.clear();
+      for (int e = static_cast<int>(std::floor(lo)); e <= static_cast<int>(std::ceil(hi)); ++e)
+        for (int m : mantissas) {
+          const double v = m * std::pow(10.0, e);
+          if (std::log10(v) >= lo && std::log10(v) <= hi) out.push_back(v);
+        }
+      if (out.size() >= 3) return out;
+    }
+    return axis_ticks(std::pow(10.0, lo), std::pow(10.0, hi), false);
   }
   const double raw = (hi - lo) / 5.0;
   const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
@@ -43,6 +37,18 @@ std::vector<double> ticks(double lo, double hi, bool log_scale) {
   // + 0.0 turns -0 (from ceil of a small negative) into 0, which prints without a sign.
   for (double k = std::ceil(lo / step); k * step <= hi + 1e-12; k += 1) out.push_back(k * step + 0.0);
   return out;
+}
+
+namespace {
+const TextStyle kTitle{16, true}, kAxis{13}, kTick{11, false, {70, 70, 70}}, kLabel{11}, kLegend{12};
+constexpr double kLabelGap = 4;  // pixels between a point label and any other text or marker
+const Rgb kBlack{0, 0, 0}, kGrid{225, 225, 225}, kFrame{60, 60, 60}, kLeader{150, 150, 150}, kLink{70, 70, 70};
+
+std::string tick_text(double v) {
+  std::ostringstream s;
+  s.precision(v != 0 && std::abs(v) < 1 ? 2 : 4);
+  s << v;
+  return s.str();
 }
 
 std::pair<double, double> padded(double lo, double hi) {
@@ -124,8 +130,8 @@ Axes layout_axes(const std::vector<double>& xs, const std::vector<double>& ys, b
   a.x_lo = x_min - x_pad;
   a.x_hi = x_max + x_pad;
   std::tie(a.y_lo, a.y_hi) = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
-  a.x_ticks = ticks(a.x_lo, a.x_hi, log_x);
-  a.y_ticks = ticks(a.y_lo, a.y_hi, false);
+  a.x_ticks = axis_ticks(a.x_lo, a.x_hi, log_x);
+  a.y_ticks = axis_ticks(a.y_lo, a.y_hi, false);
   Canvas probe(1, 1);
   double y_tick_width = 0;
   for (double v : a.y_ticks) y_tick_width = std::max(y_tick_width, probe.measure(tick_text(v), kTick).width());
@@ -405,7 +411,7 @@ std::unique_ptr<Canvas> draw_bar_chart(const BarChart& chart) {
   }
   if (chart.categories.empty() || chart.series.empty()) throw Error("bar chart '" + chart.title + "'", "nothing to plot");
   const auto [y_lo, y_hi] = padded(*std::min_element(ys.begin(), ys.end()), *std::max_element(ys.begin(), ys.end()));
-  const auto y_ticks = ticks(y_lo, y_hi, false);
+  const auto y_ticks = axis_ticks(y_lo, y_hi, false);
 
   Canvas probe(1, 1);
   double y_tick_width = 0, longest = 0, legend_width = 0;

@@ -14,6 +14,11 @@
 
 namespace cgsr {
 
+// "Nice" tick values covering [lo, hi]: multiples of 1, 2 or 5 times a power of ten. On a log axis
+// lo and hi are log10 values and the ticks values: 1, 2 and 5 of each decade, or, where that gives
+// fewer than three, every whole mantissa, or linear ticks of a range narrower still.
+std::vector<double> axis_ticks(double lo, double hi, bool log_scale);
+
 struct PlotPoint {
   double x = 0, y = 0;
   std::string label;  // drawn next to the point; "" for none

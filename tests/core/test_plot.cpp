@@ -123,6 +123,16 @@ TEST(LinePlot, LabelsNeverOverlapOrLeaveTheCanvas) {
   EXPECT_THROW(draw_line_plot(empty), Error);
 }
 
+TEST(AxisTicks, ALogAxisShowsSeveralTicksHoweverNarrow) {
+  const auto log_ticks = [](double lo, double hi) { return axis_ticks(std::log10(lo), std::log10(hi), true); };
+  EXPECT_EQ(log_ticks(0.6, 450), (std::vector<double>{1, 2, 5, 10, 20, 50, 100, 200}));
+  EXPECT_EQ(log_ticks(110, 420), (std::vector<double>{200, 300, 400}));  // 1-2-5 would give 200 alone
+  const auto narrow = log_ticks(121.5, 124.5);
+  ASSERT_GE(narrow.size(), 2u);
+  for (double v : narrow) EXPECT_TRUE(v >= 121.5 && v <= 124.5) << v;
+  EXPECT_EQ(axis_ticks(-0.3, 1.1, false), (std::vector<double>{0, 0.5, 1}));
+}
+
 TEST(BarChart, LabelsNeverOverlapOrLeaveTheCanvas) {
   BarChart c = chart("hr_unshuffle+hr_fuse - normal_angle (a long variant name)");
   c.title = "a title longer than the chart's few bars would make room for";
