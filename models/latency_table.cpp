@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include "core/error.h"
 #include "core/progress.h"
@@ -167,16 +168,13 @@ void fit_calibration(LatencyTable& table, const std::vector<LatencySample>& samp
                                            {true, false, true}, {true, false, false}}) {
     std::array<double, 3> coef{};
     if (!fit_linear(samples, active, coef) || !(coef[0] > 0) || coef[1] < 0 || coef[2] < 0) continue;
+    LatencyTable fitted;
+    std::tie(fitted.scale, fitted.element_ns, fitted.offset_ms) = std::tie(coef[0], coef[1], coef[2]);
     double error = 0;
-    for (const auto& s : samples) {
-      const double r = coef[0] * s.conv_ms + coef[1] * 1e-6 * s.elements + coef[2] - s.measured_ms;
-      error += r * r;
-    }
+    for (const auto& s : samples) error += std::pow(fitted.predict(s.conv_ms, s.elements) - s.measured_ms, 2);
     if (error >= best_error) continue;
     best_error = error;
-    table.scale = coef[0];
-    table.element_ns = coef[1];
-    table.offset_ms = coef[2];
+    std::tie(table.scale, table.element_ns, table.offset_ms) = std::tie(coef[0], coef[1], coef[2]);
   }
   if (std::isfinite(best_error)) return;
   // No timing or no convolution to fit: the sum as it is.
@@ -187,7 +185,11 @@ void fit_calibration(LatencyTable& table, const std::vector<LatencySample>& samp
 
 double LatencyTable::predict(const graph::Graph& graph) const {
   const auto [conv, elements] = features(graph);
-  return scale * conv + element_ns * 1e-6 * elements + offset_ms;
+  return predict(conv, elements);
+}
+
+double LatencyTable::predict(double conv_ms, double elements) const {
+  return scale * conv_ms + element_ns * 1e-6 * elements + offset_ms;
 }
 
 double measure_graph_latency(const graph::Graph& graph, int64_t lr_width, int64_t lr_height, int runs,

@@ -61,6 +61,7 @@ struct LatencyTable {
   // ops' output elements at the table's size. Error naming the op when a shape is not in the table.
   std::pair<double, double> features(const graph::Graph& graph) const;
   double predict(const graph::Graph& graph) const;
+  double predict(double conv_ms, double elements) const;  // from the features
 };
 
 // One whole subnet's calibration point: its features and its measured latency.

@@ -7,9 +7,7 @@
 using namespace cgsr;
 
 namespace {
-double calibrated(const LatencyTable& t, const LatencySample& s) {
-  return t.scale * s.conv_ms + t.element_ns * 1e-6 * s.elements + t.offset_ms;
-}
+double calibrated(const LatencyTable& t, const LatencySample& s) { return t.predict(s.conv_ms, s.elements); }
 }  // namespace
 
 TEST(LatencyCalibration, FitsExactlyWhenTheTimingsFollowTheModel) {
