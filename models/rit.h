@@ -36,9 +36,9 @@
 // history_out: the network's own previous output, passed back in by the runner, is warped to this
 // frame first (graph Sample at the channel's motion, bilinear or, with rit.history_warp bicubic,
 // bicubic; border padding) and zeroed where the channel's validity is 0; every part below reads
-// that instead of the raw channel. Written with
-// fixed 0/1 1x1 convs, Sample, Mul and Add: the exported file warps it too, and the state it takes
-// is the previous output as the network returned it (docs/temporal.md).
+// that instead of the raw channel. Written with fixed 0/1 1x1 convs, Sample, Mul and Add: the
+// exported file warps it too, and the state it takes is the previous output as the network
+// returned it (docs/temporal.md).
 //
 // rit.history_blend: the image blended with the history channel's samples (render_data/
 // history_channel.h; history_out's warped output instead when the RIT reads it), read from the
