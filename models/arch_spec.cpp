@@ -163,6 +163,10 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   } catch (const Error& e) {
     problems.push_back({"rit.channels", e.message()});
   }
+  for (const auto& name : spec.rit.feature_channels)
+    if (std::find(spec.rit.channels.begin(), spec.rit.channels.end(), name) == spec.rit.channels.end())
+      problems.push_back({"rit.feature_channels", "'" + name + "' is not among rit.channels [" +
+                                                      join(spec.rit.channels) + "]: the convolutions read a subset of them"});
   if (spec.rit.width < 1)
     problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)
@@ -290,6 +294,9 @@ config::Schema<RitSpec> rit_spec_schema() {
   rit.omit_when("residual_at_jitter", [](const RitSpec& r) { return !r.residual_at_jitter; });
   rit.field("history_warp", &RitSpec::history_warp, "how history_out's previous output is resampled at its motion");
   rit.omit_when("history_warp", [](const RitSpec& r) { return r.history_warp == WarpFilter::Bilinear; });
+  rit.field("feature_channels", &RitSpec::feature_channels,
+            "the channels the RIT's convolutions read, a subset of channels (empty: all)");
+  rit.omit_when("feature_channels", [](const RitSpec& r) { return r.feature_channels.empty(); });
   return rit;
 }
 
@@ -357,7 +364,8 @@ std::string spec_summary(const ArchSpec& spec) {
     s += " + rit[" + join(r.channels, "+") + widths + ", " + enum_name(r.source) + ", " + enum_name(r.fusion) + ", " + enum_name(r.depth_encoding) +
          " depth" + (r.bsp_composite ? ", bsp composite" : "") + (r.history_blend ? ", history blend" : "") +
          (r.skip_at_jitter ? (r.residual_at_jitter ? ", output at jitter" : ", skip at jitter") : "") +
-         (r.history_warp != WarpFilter::Bilinear ? ", " + enum_name(r.history_warp) + " warp" : "") + "]";
+         (r.history_warp != WarpFilter::Bilinear ? ", " + enum_name(r.history_warp) + " warp" : "") +
+         (r.feature_channels.empty() ? "" : ", convolving " + join(r.feature_channels, "+")) + "]";
   }
   if (spec.geometry.enabled) s += " + geometry head";
   return s;

@@ -54,17 +54,27 @@ RitBlockImpl::RitBlockImpl(const RitSpec& rit, int scale, FusionPoint features, 
   CGSR_CHECK(c > 0 && rit.width > 0 && rit.hr_width > 0, "RIT needs channels and positive widths");
   ParameterBudget::charge(c);
   gate = register_parameter("gate", torch::ones({c}));
+  const auto convolved = rit.convolved_channels();
+  const int64_t read = total_width(convolved);
+  if (!rit.feature_channels.empty()) {
+    feature_layout_ = info_layout(convolved);
+    feature_select_ = torch::zeros({read, c, 1, 1});
+    int64_t row = 0;
+    for (auto channel : convolved)
+      for (int64_t k = 0; k < channel_width(channel); ++k, ++row)
+        feature_select_[row][channel_offset(rit.render_channels(), channel) + k] = 1.0f;
+  }
   if (rit.feature_branch()) {
     // Space-to-depth + conv 3x3 == a conv of kernel 3s, stride s, padding s on the HR map.
-    ParameterBudget::charge_conv(c, rit.width, 3 * stride_, 1, /*bias=*/true);
-    conv = register_module("conv", torch::nn::Conv2d(torch::nn::Conv2dOptions(c, rit.width, 3 * stride_)
+    ParameterBudget::charge_conv(read, rit.width, 3 * stride_, 1, /*bias=*/true);
+    conv = register_module("conv", torch::nn::Conv2d(torch::nn::Conv2dOptions(read, rit.width, 3 * stride_)
                                                          .stride(stride_)
                                                          .padding(stride_)));
     fuse = register_module("fuse", make_fusion(concat_, features.channels, rit.width));
   }
   if (rit.hr_branch()) {
     CGSR_CHECK(hr_features.factor == scale, "RIT: the HR fusion point must be at the output resolution");
-    hr_conv = register_module("hr_conv", make_conv(c, rit.hr_width, 3));
+    hr_conv = register_module("hr_conv", make_conv(read, rit.hr_width, 3));
     hr_fuse = register_module("hr_fuse", make_fusion(concat_, hr_features.channels, rit.hr_width));
   }
   if (rit.bsp_composite) {
@@ -141,7 +151,8 @@ int RitBlockImpl::describe_warp_previous_output(graph::Builder& g, int info) con
 
 torch::Tensor RitBlockImpl::gate_info(const torch::Tensor& info) const {
   const auto x = pool_factor_ > 1 ? graph::apply_avg_pool(info, pool_factor_) : info;
-  return graph::apply_affine(x, gate, {});
+  const auto gated = graph::apply_affine(x, gate, {});
+  return feature_select_.defined() ? torch::conv2d(gated, feature_select_) : gated;
 }
 
 torch::Tensor RitBlockImpl::join(const torch::Tensor& features, const torch::Tensor& x, torch::nn::Conv2d& fusion) {
@@ -166,7 +177,9 @@ torch::Tensor RitBlockImpl::fuse_hr(const torch::Tensor& hr_features, const torc
 
 int RitBlockImpl::describe_gate(graph::Builder& g, int info) const {
   const int x = pool_factor_ > 1 ? g.avg_pool(info, pool_factor_) : info;
-  return g.affine("gate", x, gate, {}, /*trainable=*/true);
+  const int gated = g.affine("gate", x, gate, {}, /*trainable=*/true);
+  if (!feature_select_.defined()) return gated;
+  return g.conv("feature_select", gated, feature_select_, {}, 0, feature_layout_, /*trainable=*/false);
 }
 
 int RitBlockImpl::describe_features(graph::Builder& g, int features, int gated) const {

@@ -92,7 +92,8 @@ class RitBlockImpl : public torch::nn::Module {
   bool reads_previous_output() const { return previous_keep_.defined(); }
   torch::Tensor warp_previous_output(const torch::Tensor& info) const;
   int describe_warp_previous_output(graph::Builder& g, int info) const;
-  // The gated information both parts read (hr_pooled: pooled first, as the gate always was).
+  // The gated information both parts read (hr_pooled: pooled first, as the gate always was),
+  // narrowed to rit.feature_channels when set.
   torch::Tensor gate_info(const torch::Tensor& info) const;
   torch::Tensor fuse_features(const torch::Tensor& features, const torch::Tensor& gated);
   torch::Tensor fuse_hr(const torch::Tensor& hr_features, const torch::Tensor& gated);
@@ -151,6 +152,10 @@ class RitBlockImpl : public torch::nn::Module {
   // motion, and [C, 3, 1, 1] the warped colour back into the colour's place.
   torch::Tensor previous_color_, previous_validity_, previous_motion_, previous_keep_, previous_embed_;
   graph::ResizeMode previous_warp_ = graph::ResizeMode::Bilinear;  // rit.history_warp
+  // rit.feature_channels: a constant [C', C, 1, 1] 0/1 selection of the channels the convolutions
+  // read, and their layout; undefined when they read all.
+  torch::Tensor feature_select_;
+  graph::Layout feature_layout_;
   int64_t scale_;
 };
 TORCH_MODULE(RitBlock);

@@ -240,3 +240,22 @@ TEST(ArchSpec, HistoryWarpNeedsThePreviousOutput) {
   EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
   EXPECT_NE(spec_summary(s).find("bicubic warp"), std::string::npos) << spec_summary(s);
 }
+
+// rit.feature_channels: a channel the RIT does not read is an error naming the key and the
+// channels; written only when set, and read back the same.
+TEST(ArchSpec, FeatureChannelsAreASubsetOfTheChannels) {
+  const std::string unread =
+      parse_error("backbone: pan\nrit: {enabled: true, channels: [edge], source: hr_fuse, feature_channels: [depth]}\n");
+  EXPECT_NE(unread.find("rit.feature_channels"), std::string::npos) << unread;
+  EXPECT_NE(unread.find("'depth' is not among rit.channels [edge]"), std::string::npos) << unread;
+  ArchSpec s = default_spec("pan", 2);
+  s.rit.enabled = true;
+  s.rit.channels = {"edge", "jitter"};
+  s.rit.source = RitSource::HrFuse;
+  EXPECT_EQ(spec_to_yaml(s).find("feature_channels"), std::string::npos);
+  s.rit.feature_channels = {"edge"};
+  const std::string yaml = spec_to_yaml(s);
+  EXPECT_NE(yaml.find("feature_channels"), std::string::npos) << yaml;
+  EXPECT_EQ(spec_from_yaml(yaml, "roundtrip"), s);
+  EXPECT_NE(spec_summary(s).find("convolving edge"), std::string::npos) << spec_summary(s);
+}

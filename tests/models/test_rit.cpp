@@ -536,3 +536,35 @@ TEST(Rit, HistoryOutWarpsThePreviousOutputWhereValid) {
       EXPECT_TRUE(torch::allclose(fast, served, 1e-4, 1e-4)) << (fast - served).abs().max().item<float>();
     }
 }
+
+// rit.feature_channels: the convolutions read the listed channels alone (here edge, the second of
+// the information's channels), with fewer weights; an unlisted channel changes nothing unless an
+// option reads it.
+TEST(Rit, FeatureChannelsAreAllTheConvolutionsRead) {
+  torch::manual_seed(43);
+  for (const auto& source : rit_sources_for("pan")) {
+    SCOPED_TRACE(source);
+    ArchSpec spec = with_rit(default_spec("pan", 4), source);
+    spec.rit.channels = {"depth", "edge"};
+    const ArchSpec all = resolve_spec(spec);
+    spec.rit.feature_channels = {"edge"};
+    SRNetwork net(resolve_spec(spec)), wide(all);
+    EXPECT_LT(total_parameter_count(*net), total_parameter_count(*wide));
+    randomize_fusion(*net, 0.1);
+    const auto [color, info] = random_inputs(net->spec(), 7, 5);
+    torch::NoGradGuard no_grad;
+    const auto out = net->forward(color, info);
+    auto depth = info.clone();
+    depth.select(1, 0).uniform_(0, 1);
+    EXPECT_TRUE(torch::equal(net->forward(color, depth), out));
+    auto edge = info.clone();
+    edge.select(1, 1).uniform_(0, 1);
+    EXPECT_FALSE(torch::equal(net->forward(color, edge), out));
+    const auto deployed = net->describe(/*training=*/false);
+    const auto served = graph::run(deployed, network_inputs(deployed, color, info)).front().second;
+    EXPECT_TRUE(torch::allclose(served, out, 1e-5, 1e-5)) << (served - out).abs().max().item<float>();
+    FusedGraph fused(deployed);
+    const auto fast = fused.run(color, info);
+    EXPECT_TRUE(torch::allclose(fast, out, 1e-4, 1e-4)) << (fast - out).abs().max().item<float>();
+  }
+}
