@@ -164,8 +164,8 @@ TEST(RecurrentNetwork, EvaluationRunsEachSceneInOrderFromItsFirstFrame) {
   EXPECT_EQ(r.frames.front().frame, 3);
 }
 
-// A recurrent PAN x2 (depth and history_out through hr_fuse, its previous output blended in)
-// trains 2 steps on sequences and is evaluated twice to the same outputs; the frame after the cut
+// A recurrent PAN x2 (depth and history_out, its convolution reading depth alone through hr_fuse,
+// its previous output blended in) trains 2 steps on sequences and is evaluated twice to the same outputs; the frame after the cut
 // is what the network gives that frame alone, a frame inside a scene is not; ONNX Runtime
 // reproduces the exported file over 8 frames across the cut, each fed cgsr's previous output.
 TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
@@ -174,6 +174,7 @@ TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
                               " --model pan --steps 2 --threads 1 --set schedule.batch_size=2 --set schedule.patch_size=16"
                               " --set schedule.val_frames=1 --set enhance.enabled=true"
                               " --set 'enhance.rit.channels=[depth, history_out]' --set enhance.rit.history_blend=true"
+                              " --set 'enhance.rit.feature_channels=[depth]'"
                               " --set enhance.rit.source=hr_fuse --set enhance.rit.hr_width=4"
                               " --set enhance.geometry.enabled=false --out " + (dir / "train").string());
   ASSERT_EQ(train.exit_code, 0) << train.all();
