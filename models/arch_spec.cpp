@@ -163,10 +163,15 @@ std::vector<Problem> find_problems(const ArchSpec& spec) {
   } catch (const Error& e) {
     problems.push_back({"rit.channels", e.message()});
   }
-  for (const auto& name : spec.rit.feature_channels)
-    if (std::find(spec.rit.channels.begin(), spec.rit.channels.end(), name) == spec.rit.channels.end())
-      problems.push_back({"rit.feature_channels", "'" + name + "' is not among rit.channels [" +
-                                                      join(spec.rit.channels) + "]: the convolutions read a subset of them"});
+  try {
+    parse_channels(spec.rit.feature_channels);
+    for (const auto& name : spec.rit.feature_channels)
+      if (std::find(spec.rit.channels.begin(), spec.rit.channels.end(), name) == spec.rit.channels.end())
+        problems.push_back({"rit.feature_channels", "'" + name + "' is not among rit.channels [" +
+                                                        join(spec.rit.channels) + "]: the convolutions read a subset of them"});
+  } catch (const Error& e) {
+    problems.push_back({"rit.feature_channels", e.message()});
+  }
   if (spec.rit.width < 1)
     problems.push_back({"rit.width", config::out_of_range(spec.rit.width, 1, config::kUnbounded)});
   if (spec.rit.hr_width < 1)

@@ -165,9 +165,10 @@ TEST(RecurrentNetwork, EvaluationRunsEachSceneInOrderFromItsFirstFrame) {
 }
 
 // A recurrent PAN x2 (depth and history_out, its convolution reading depth alone through hr_fuse,
-// its previous output blended in) trains 2 steps on sequences and is evaluated twice to the same outputs; the frame after the cut
-// is what the network gives that frame alone, a frame inside a scene is not; ONNX Runtime
-// reproduces the exported file over 8 frames across the cut, each fed cgsr's previous output.
+// its previous output blended in) trains 2 steps on sequences and is evaluated twice to the same
+// outputs; the frame after the cut is what the network gives that frame alone, a frame inside a
+// scene is not; ONNX Runtime reproduces the exported file over 8 frames across the cut, each fed
+// cgsr's previous output.
 TEST(RecurrentNetwork, TrainsEvaluatesAndExportsOverASequenceWithACut) {
   const auto dir = test::scratch_dir("recurrent-train");
   const auto train = run_cgsr("train --data " + walk_set().string() +

@@ -248,6 +248,10 @@ TEST(ArchSpec, FeatureChannelsAreASubsetOfTheChannels) {
       parse_error("backbone: pan\nrit: {enabled: true, channels: [edge], source: hr_fuse, feature_channels: [depth]}\n");
   EXPECT_NE(unread.find("rit.feature_channels"), std::string::npos) << unread;
   EXPECT_NE(unread.find("'depth' is not among rit.channels [edge]"), std::string::npos) << unread;
+  const std::string twice =
+      parse_error("backbone: pan\nrit: {enabled: true, channels: [edge], source: hr_fuse, feature_channels: [edge, edge]}\n");
+  EXPECT_NE(twice.find("rit.feature_channels"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("listed twice"), std::string::npos) << twice;
   ArchSpec s = default_spec("pan", 2);
   s.rit.enabled = true;
   s.rit.channels = {"edge", "jitter"};
